@@ -1,0 +1,51 @@
+"""Exceptions raised by discsim.
+
+Every error raised for bad user input is a :class:`DiscsimError`; most are also
+:class:`ValueError` so that generic ``except ValueError`` handlers still work.
+Each message names the offending disc (by index) and the offending value.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "BoxTooSmallError",
+    "CheckpointError",
+    "DiscsimError",
+    "InvalidDiscsError",
+    "OutsideBoxError",
+    "OverlapError",
+    "PackingError",
+    "TimeError",
+]
+
+
+class DiscsimError(Exception):
+    """Base class of every error discsim raises on purpose."""
+
+
+class InvalidDiscsError(DiscsimError, ValueError):
+    """Wrong shape, non-finite value, bad radius or mass, or a moving obstacle."""
+
+
+class OutsideBoxError(DiscsimError, ValueError):
+    """A disc lies outside the box or is cut by a wall."""
+
+
+class OverlapError(DiscsimError, ValueError):
+    """Two discs overlap; the message names the pair and the depth."""
+
+
+class BoxTooSmallError(DiscsimError, ValueError):
+    """The box cannot hold the cell grid the engine needs (3 cells a side when periodic)."""
+
+
+class PackingError(DiscsimError, ValueError):
+    """A requested packing fraction cannot be reached."""
+
+
+class TimeError(DiscsimError, ValueError):
+    """A time that lies in the simulated past, or is not finite."""
+
+
+class CheckpointError(DiscsimError, ValueError):
+    """A checkpoint or event-log file that is damaged, foreign or incompatible."""

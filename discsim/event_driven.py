@@ -1,0 +1,448 @@
+"""The event-driven engine (PIC): jump from one predicted collision to the next.
+
+State is a struct of plain Python lists (the hot loop reads floats, not numpy
+scalars). Each disc carries a reference position ``r`` at its own reference
+time ``tr`` and flies straight, ``r + v (t - tr)``, until its velocity
+changes: an event touches only the discs it involves (lazy clocks).
+
+Each moving disc owns at most one pending event in the queue: the earliest of
+its next wall hit, its next cell crossing and its next collision with a disc
+in the 3x3 cells around it. A collision event carries the partner's collision
+counter at prediction time and is stale when popped if the partner's counter
+has moved on. The owner's own event is replaced whenever the owner is
+re-predicted, so the queue never holds more than N events.
+
+The hot loop, :meth:`EventDriven._process`, reads top to bottom: pop,
+validate the counter, advance the discs involved, resolve, record,
+re-predict, push.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from discsim.engine import Engine, Event
+from discsim.eventlog import KIND_NAMES, EventLog
+from discsim.grid import CellGrid, check_fits
+from discsim.kernels import resolve_collision
+from discsim.queue import EventQueue, HeapEventQueue
+from discsim.state import Box, Discs
+
+__all__ = ["EventDriven"]
+
+INF = math.inf
+# Kinds of queued events. COLLISION and WALL match discsim.eventlog.
+_COLLISION, _WALL, _CROSSING = 0, 1, 2
+# Directions of a cell crossing.
+_PLUS_X, _MINUS_X, _PLUS_Y, _MINUS_Y = 0, 1, 2, 3
+
+_QUEUES = {"sorted": EventQueue, "heap": HeapEventQueue}
+
+
+class EventDriven(Engine):
+    """Exact event-driven simulation of elastic hard discs (PIC).
+
+    Args:
+        discs: the discs at ``time = 0``.
+        box: the box (reflecting walls or periodic).
+        record: keep the event log (needed by ``events`` and ``trajectory``);
+            switch off for long runs so memory stays flat.
+        queue: ``"sorted"`` (a ``sortedcontainers.SortedList``, the default) or
+            ``"heap"`` (``heapq`` with lazy deletion).
+        cell_size: side of the grid cells; default the largest disc diameter,
+            grown where needed so that there are at most ``2 N + 9`` cells.
+            Never below the largest diameter.
+
+    Raises:
+        OutsideBoxError, OverlapError: if the discs do not fit in the box.
+        BoxTooSmallError: if a periodic box has fewer than 3 cells a side.
+
+    Attributes:
+        time (float): the current simulated time.
+        counts (dict[str, int]): ``collisions`` (disc-disc), ``wall_hits``,
+            ``cell_crossings``, ``stale`` (invalidated events popped) and
+            ``predictions`` (discs re-predicted).
+
+    Example:
+        >>> import discsim as ds
+        >>> discs = ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], radii=1.0)
+        >>> sim = ds.EventDriven(discs, ds.Box(10.0, 10.0)).run(until=2.5)
+        >>> sim.counts["collisions"], sim.velocities.tolist()
+        (1, [[-1.0, 0.0], [1.0, 0.0]])
+    """
+
+    def __init__(
+        self,
+        discs: Discs,
+        box: Box,
+        *,
+        record: bool = True,
+        queue: str = "sorted",
+        cell_size: float | None = None,
+    ):
+        super().__init__(discs, box, record)
+        if queue not in _QUEUES:
+            msg = f"queue must be one of {sorted(_QUEUES)}, got {queue!r}"
+            raise ValueError(msg)
+        check_fits(discs, box)
+        n = len(discs)
+        diameter = 2.0 * float(discs.radii.max()) if n else 1.0
+        if cell_size is None:
+            grid = CellGrid(box, diameter, max_cells=2 * n + 9)
+        else:
+            if not cell_size >= diameter:
+                msg = f"cell_size {cell_size!r} is below the largest disc diameter {diameter!r}"
+                raise ValueError(msg)
+            grid = CellGrid(box, float(cell_size))
+        self.grid = grid
+        self.time = 0.0
+        self.queue_kind = queue
+        pos, vel = discs.positions, discs.velocities
+        self._rx, self._ry = pos[:, 0].tolist(), pos[:, 1].tolist()
+        self._vx, self._vy = vel[:, 0].tolist(), vel[:, 1].tolist()
+        self._tr = [0.0] * n
+        self._radius = discs.radii.tolist()
+        self._mass = discs.masses.tolist()
+        self._moving = np.isfinite(discs.masses).tolist()
+        self._count = [0] * n
+        self._cell = grid.cells_of(pos).tolist()
+        self._cells: list[list[int]] = [[] for _ in range(len(grid))]
+        for i, c in enumerate(self._cell):
+            self._cells[c].append(i)
+        self._queue = _QUEUES[queue](n)
+        self._log = EventLog()
+        self._virial = 0.0
+        self._last = None
+        self.counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0, "predictions": 0}
+        self.max_queue = 0
+        for i in range(n):
+            if self._moving[i]:
+                self._predict(i, 0.0, -1)
+        self.max_queue = len(self._queue)
+
+    # --- public protocol -------------------------------------------------------------
+    @property
+    def positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
+        t = self.time
+        rx, ry, tr = np.array(self._rx), np.array(self._ry), np.array(self._tr)
+        vx, vy = np.array(self._vx), np.array(self._vy)
+        out = np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)])
+        return self.box.wrap(out) if len(out) else out.reshape(0, 2)
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
+        return np.column_stack([self._vx, self._vy]) if self._vx else np.zeros((0, 2))
+
+    def _event_array(self) -> np.ndarray:
+        return self._log.to_array()
+
+    @property
+    def queue_size(self) -> int:
+        """Events pending in the queue now (at most N)."""
+        return len(self._queue)
+
+    def pressure(self) -> float:
+        """Pressure from the collision virial, averaged since the start.
+
+        ``P = (N kT + W / (2 t)) / A`` in 2D, with ``N kT`` the kinetic energy,
+        ``W`` the sum over disc-disc collisions of ``dp_i . (r_i - r_j)`` and
+        ``A`` the box area. With walls this is the bulk estimate (wall contacts
+        are not counted). Units: energy per area.
+        """
+        elapsed = self.time - self.start_time
+        if elapsed <= 0:
+            msg = "pressure() needs a run of positive duration"
+            raise ValueError(msg)
+        return (self.kinetic_energy() + self._virial / (2.0 * elapsed)) / self.box.area
+
+    def run(self, until: float | None = None, *, events: int | None = None, progress: bool = False):
+        """Process events up to time ``until`` and/or for ``events`` physical events.
+
+        Args:
+            until: stop time; events at exactly ``until`` are processed and
+                ``time`` is set to ``until`` at the end.
+            events: stop after this many collisions plus wall hits (cell
+                crossings and stale events are bookkeeping and not counted).
+            progress: show a tqdm progress bar.
+
+        Returns:
+            ``self``, so calls chain.
+
+        Raises:
+            TimeError: if ``until`` is before ``time`` or NaN.
+            ValueError: if neither limit is given, or ``events`` is negative.
+        """
+        if until is None and events is None:
+            msg = "run() needs until=... or events=..."
+            raise ValueError(msg)
+        limit_t = INF if until is None else self._check_until(until)
+        if events is not None and (int(events) != events or events < 0):
+            msg = f"events must be a non-negative integer, got {events!r}"
+            raise ValueError(msg)
+        limit_n = -1 if events is None else int(events)
+        if progress:
+            done = self._run_with_progress(limit_t, limit_n)
+        else:
+            done = self._process(limit_t, limit_n)
+        if limit_t != INF and done != limit_n:  # stopped by the clock, not by the event count
+            self.time = limit_t
+        return self
+
+    def _run_with_progress(self, limit_t: float, limit_n: int) -> int:
+        from discsim.progress import progress_bar
+
+        by_time = limit_n < 0
+        total = (limit_t - self.time) if by_time else limit_n
+        with progress_bar(total, by_time=by_time) as bar:
+            done = 0
+            while True:
+                chunk = 20_000 if limit_n < 0 else min(20_000, limit_n - done)
+                t0 = self.time
+                k = self._process(limit_t, chunk)
+                done += k
+                bar.update(self.time - t0 if by_time else k, self.counts["collisions"])
+                if k < chunk or (limit_n >= 0 and done >= limit_n) or chunk == 0:
+                    break
+            if by_time and limit_t != INF and (limit_n < 0 or done < limit_n):
+                bar.update(limit_t - self.time, self.counts["collisions"])
+        return done
+
+    def step(self) -> Event | None:
+        """Process events up to and including the next collision or wall hit.
+
+        Returns:
+            The :class:`~discsim.engine.Event` processed, or None if no disc
+            will ever hit anything.
+        """
+        if self._process(INF, 1) == 0:
+            return None
+        t, kind, i, j = self._last
+        return Event(t, KIND_NAMES[kind], i, j)
+
+    # --- prediction ------------------------------------------------------------------
+    def _predict(self, i: int, t: float, exclude: int) -> None:
+        """Schedule disc ``i``'s earliest event after time ``t`` (never with ``exclude``).
+
+        The 3x3 neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
+        """
+        rx, ry, vx, vy, tr, radius = self._rx, self._ry, self._vx, self._vy, self._tr, self._radius
+        grid = self.grid
+        vxi, vyi = vx[i], vy[i]
+        dti = t - tr[i]
+        xi = rx[i] + vxi * dti
+        yi = ry[i] + vyi * dti
+        ri = radius[i]
+        c = self._cell[i]
+        cx, cy = divmod(c, grid.ny)
+        periodic = self.box.periodic
+        best, kind, other = INF, _CROSSING, 0
+        # Cell crossings and walls.
+        if vxi > 0.0:
+            if periodic or cx < grid.nx - 1:
+                best, other = ((cx + 1) * grid.lx - xi) / vxi, _PLUS_X
+            elif not periodic:
+                best, kind, other = (self.box.width - ri - xi) / vxi, _WALL, 0
+        elif vxi < 0.0:
+            if periodic or cx > 0:
+                best, other = (cx * grid.lx - xi) / vxi, _MINUS_X
+            elif not periodic:
+                best, kind, other = (ri - xi) / vxi, _WALL, 0
+        if vyi > 0.0:
+            if periodic or cy < grid.ny - 1:
+                ty, ky, oy = ((cy + 1) * grid.ly - yi) / vyi, _CROSSING, _PLUS_Y
+            else:
+                ty, ky, oy = (self.box.height - ri - yi) / vyi, _WALL, 1
+            if ty < best:
+                best, kind, other = ty, ky, oy
+        elif vyi < 0.0:
+            if periodic or cy > 0:
+                ty, ky, oy = (cy * grid.ly - yi) / vyi, _CROSSING, _MINUS_Y
+            else:
+                ty, ky, oy = (ri - yi) / vyi, _WALL, 1
+            if ty < best:
+                best, kind, other = ty, ky, oy
+        if best < 0.0:
+            best = 0.0
+        # Collisions with discs in the 3x3 block of cells.
+        cells = self._cells
+        sqrt = math.sqrt
+        for c2, (sx, sy) in zip(grid.neighbours[c], grid.shifts[c]):
+            for j in cells[c2]:
+                if j == i or j == exclude:
+                    continue
+                dvx = vx[j] - vxi
+                dvy = vy[j] - vyi
+                dtj = t - tr[j]
+                dx = rx[j] + vx[j] * dtj + sx - xi
+                dy = ry[j] + vy[j] * dtj + sy - yi
+                b = dx * dvx + dy * dvy
+                if b >= 0.0:
+                    continue
+                s = ri + radius[j]
+                cc = dx * dx + dy * dy - s * s
+                if cc <= 0.0:
+                    tij = 0.0
+                else:
+                    a = dvx * dvx + dvy * dvy
+                    disc = b * b - a * cc
+                    if disc <= 0.0:
+                        continue
+                    tij = cc / (-b + sqrt(disc))
+                if tij < best:
+                    best, kind, other = tij, _COLLISION, j
+        self.counts["predictions"] += 1
+        if best == INF:
+            self._queue.discard(i)
+        elif kind == _COLLISION:
+            self._queue.push(i, t + best, (_COLLISION, other, self._count[other]))
+        else:
+            self._queue.push(i, t + best, (kind, other, 0))
+
+    # --- the hot loop ----------------------------------------------------------------
+    def _process(self, until: float, limit: int) -> int:
+        """Process events with time <= ``until``; stop after ``limit`` physical events (-1: none).
+
+        Returns the number of physical events (collisions plus wall hits) processed.
+        """
+        queue = self._queue
+        pop, peek = queue.pop, queue.peek
+        predict = self._predict
+        rx, ry, vx, vy, tr = self._rx, self._ry, self._vx, self._vy, self._tr
+        count, mass, moving = self._count, self._mass, self._moving
+        cell, cells, grid = self._cell, self._cells, self.grid
+        nx, ny = grid.nx, grid.ny
+        width, height, periodic = self.box.width, self.box.height, self.box.periodic
+        log = self._log if self.record else None
+        counts = self.counts
+        n_coll = n_wall = n_cross = n_stale = 0
+        done = 0
+        max_queue = self.max_queue
+        now, last, virial = self.time, None, self._virial
+        while done != limit and peek() <= until:
+            t, i, (kind, other, stamp) = pop()
+            if kind == _COLLISION:
+                j = other
+                if count[j] != stamp:  # the partner has changed course since the prediction
+                    n_stale += 1
+                    predict(i, t, -1)
+                    continue
+                # Advance the two discs to the contact.
+                dt = t - tr[i]
+                xi = rx[i] = rx[i] + vx[i] * dt
+                yi = ry[i] = ry[i] + vy[i] * dt
+                tr[i] = t
+                dt = t - tr[j]
+                xj = rx[j] = rx[j] + vx[j] * dt
+                yj = ry[j] = ry[j] + vy[j] * dt
+                tr[j] = t
+                dx, dy = xj - xi, yj - yi
+                if periodic:
+                    dx -= width * round(dx / width)
+                    dy -= height * round(dy / height)
+                vxi, vyi, vxj, vyj = vx[i], vy[i], vx[j], vy[j]
+                uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mass[i], mass[j])
+                vx[i], vy[i], vx[j], vy[j] = uxi, uyi, uxj, uyj
+                virial -= mass[i] * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
+                count[i] += 1
+                n_coll += 1
+                done += 1
+                if log is not None:
+                    log.collision(t, i, j, xi, yi, uxi, uyi, xj, yj, uxj, uyj)
+                predict(i, t, j)
+                if moving[j]:
+                    count[j] += 1
+                    predict(j, t, i)
+                last = (t, _COLLISION, i, j)
+            elif kind == _WALL:
+                dt = t - tr[i]
+                xi = rx[i] = rx[i] + vx[i] * dt
+                yi = ry[i] = ry[i] + vy[i] * dt
+                tr[i] = t
+                if other == 0:
+                    vx[i] = -vx[i]
+                else:
+                    vy[i] = -vy[i]
+                count[i] += 1
+                n_wall += 1
+                done += 1
+                if log is not None:
+                    log.wall(t, i, xi, yi, vx[i], vy[i])
+                predict(i, t, -1)
+                last = (t, _WALL, i, -1)
+            else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
+                c = cell[i]
+                cells[c].remove(i)
+                cx, cy = divmod(c, ny)
+                if other == _PLUS_X:
+                    cx += 1
+                    if cx == nx:
+                        cx = 0
+                        rx[i] -= width
+                elif other == _MINUS_X:
+                    cx -= 1
+                    if cx < 0:
+                        cx = nx - 1
+                        rx[i] += width
+                elif other == _PLUS_Y:
+                    cy += 1
+                    if cy == ny:
+                        cy = 0
+                        ry[i] -= height
+                else:
+                    cy -= 1
+                    if cy < 0:
+                        cy = ny - 1
+                        ry[i] += height
+                c = cx * ny + cy
+                cell[i] = c
+                cells[c].append(i)
+                n_cross += 1
+                predict(i, t, -1)
+            now = t
+            size = len(queue)
+            if size > max_queue:
+                max_queue = size
+        self.max_queue = max_queue
+        self.time, self._virial = now, virial
+        if last is not None:
+            self._last = last
+        counts["collisions"] += n_coll
+        counts["wall_hits"] += n_wall
+        counts["cell_crossings"] += n_cross
+        counts["stale"] += n_stale
+        return done
+
+    # --- invariants ------------------------------------------------------------------
+    def _check(self) -> None:
+        """Assert every internal invariant; O(N). Called by the stress tests after each step."""
+        self._queue._check()
+        n = len(self.discs)
+        assert len(self._queue) <= n
+        seen = sorted(j for members in self._cells for j in members)
+        assert seen == list(range(n)), "every disc is in exactly one cell"
+        pos = self.positions
+        expected = self.grid.cells_of(pos)
+        grid = self.grid
+        for i in range(n):
+            c = self._cell[i]
+            assert i in self._cells[c]
+            if expected[i] != c:  # only allowed on a cell boundary, within roundoff
+                cx, cy = divmod(c, grid.ny)
+                x, y = pos[i]
+                tol = 1e-9 * max(grid.lx, grid.ly)
+                inside_x = cx * grid.lx - tol <= x <= (cx + 1) * grid.lx + tol or (
+                    self.box.periodic and (x < tol or x > self.box.width - tol)
+                )
+                inside_y = cy * grid.ly - tol <= y <= (cy + 1) * grid.ly + tol or (
+                    self.box.periodic and (y < tol or y > self.box.height - tol)
+                )
+                assert inside_x and inside_y, f"disc {i} at {pos[i]} is not in its cell {c}"
+            t_pending, payload = self._queue.pending(i)
+            assert t_pending >= self.time - 1e-12 * max(1.0, self.time)
+            if self._moving[i] and (self._vx[i] or self._vy[i]):
+                assert payload is not None or t_pending == INF
+        check_fits(Discs(pos, self.velocities, self.discs.radii, self.discs.masses), self.box)

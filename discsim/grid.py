@@ -1,0 +1,244 @@
+"""Cell grids: the engine's neighbour table and vectorised neighbour pairs.
+
+Two views of one idea. :class:`CellGrid` is the event-driven engine's grid:
+plain Python tables, so a prediction looks only at the 3x3 cells around a disc.
+:func:`neighbour_pairs` finds every pair of discs in the same or adjacent cells
+with numpy, for bulk work (input checks, the fixed-step broad phase).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from discsim.errors import BoxTooSmallError, OutsideBoxError, OverlapError
+from discsim.state import OVERLAP_TOLERANCE, Box, Discs
+
+__all__ = ["CellGrid", "check_fits", "neighbour_pairs"]
+
+
+def _cells_along(length: float, min_cell: float, periodic: bool, axis: str) -> int:
+    n = max(1, math.floor(length / min_cell * (1 + 1e-12)))
+    if periodic and n < 3:
+        msg = (
+            f"periodic box {axis}-extent {length:g} is too small for its cell grid: it needs at "
+            f"least 3 cells of side >= {min_cell:g} (the largest disc diameter), i.e. >= {3 * min_cell:g}"
+        )
+        raise BoxTooSmallError(msg)
+    return n
+
+
+class CellGrid:
+    """A uniform ``nx`` by ``ny`` grid of cells over a box.
+
+    Args:
+        box: the box to cover.
+        min_cell_size: smallest allowed cell side (at least the largest disc
+            diameter, so that touching discs are always in adjacent cells).
+        max_cells: upper bound on ``nx * ny``; cells grow beyond
+            ``min_cell_size`` to respect it (few discs in a large box).
+
+    Raises:
+        BoxTooSmallError: if the box is periodic and fewer than 3 cells fit
+            along a side (the minimum image would then be ambiguous).
+
+    Attributes:
+        nx, ny (int): cells along x and y. ``lx, ly`` (float): cell sides.
+        neighbours (list[tuple[int, ...]]): for each cell, the distinct cells of
+            its 3x3 block (itself included).
+        shifts (list[tuple[tuple[float, float], ...]]): for each cell, one
+            ``(sx, sy)`` per neighbour: the offset to add to a neighbour's
+            position to get its image next to the cell (zero except across a
+            periodic edge). Equal tuples are shared to keep the table small.
+    """
+
+    def __init__(self, box: Box, min_cell_size: float, max_cells: int | None = None):
+        if not (min_cell_size > 0 and math.isfinite(min_cell_size)):
+            msg = f"min_cell_size must be positive and finite, got {min_cell_size!r}"
+            raise ValueError(msg)
+        nx = _cells_along(box.width, min_cell_size, box.periodic, "x")
+        ny = _cells_along(box.height, min_cell_size, box.periodic, "y")
+        if max_cells is not None and nx * ny > max_cells:
+            scale = math.sqrt(nx * ny / max_cells)
+            floor_n = 3 if box.periodic else 1
+            nx = max(floor_n, int(nx / scale))
+            ny = max(floor_n, int(ny / scale))
+        self.box = box
+        self.nx, self.ny = nx, ny
+        self.lx, self.ly = box.width / nx, box.height / ny
+        self.neighbours, self.shifts = self._build_tables()
+
+    def __len__(self) -> int:
+        return self.nx * self.ny
+
+    def cell_index(self, cx: int, cy: int) -> int:
+        """Flat index of cell column ``cx``, row ``cy``."""
+        return cx * self.ny + cy
+
+    def cell_of(self, x: float, y: float) -> int:
+        """Flat index of the cell holding point ``(x, y)`` (clamped to the grid)."""
+        cx = min(max(int(x / self.lx), 0), self.nx - 1)
+        cy = min(max(int(y / self.ly), 0), self.ny - 1)
+        return cx * self.ny + cy
+
+    def cells_of(self, positions: np.ndarray) -> np.ndarray:
+        """Flat cell index ``(N,)`` of each row of ``positions`` ``(N, 2)``."""
+        cx = np.clip((positions[:, 0] / self.lx).astype(np.int64), 0, self.nx - 1)
+        cy = np.clip((positions[:, 1] / self.ly).astype(np.int64), 0, self.ny - 1)
+        return cx * self.ny + cy
+
+    def _build_tables(self):
+        nx, ny, periodic = self.nx, self.ny, self.box.periodic
+        width, height = self.box.width, self.box.height
+        ids = list(range(nx * ny))  # shared int objects keep the table small
+        neighbours: list[tuple[int, ...]] = []
+        shifts: list[tuple] = []
+        shared: dict[tuple, tuple] = {}
+        for cx in range(nx):
+            for cy in range(ny):
+                cells, offs = [], []
+                for dx in (-1, 0, 1):
+                    ox, sx = cx + dx, 0.0
+                    if periodic:
+                        if ox < 0:
+                            ox, sx = ox + nx, -width
+                        elif ox >= nx:
+                            ox, sx = ox - nx, width
+                    elif not 0 <= ox < nx:
+                        continue
+                    for dy in (-1, 0, 1):
+                        oy, sy = cy + dy, 0.0
+                        if periodic:
+                            if oy < 0:
+                                oy, sy = oy + ny, -height
+                            elif oy >= ny:
+                                oy, sy = oy - ny, height
+                        elif not 0 <= oy < ny:
+                            continue
+                        cell = ids[ox * ny + oy]
+                        if cell in cells:
+                            continue
+                        cells.append(cell)
+                        offs.append((sx, sy))
+                neighbours.append(tuple(cells))
+                offs = tuple(offs)
+                shifts.append(shared.setdefault(offs, offs))
+        return neighbours, shifts
+
+
+def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
+    """All pairs of points closer than ``cell_size`` candidates, found with a cell grid.
+
+    Every pair whose separation (minimum image when periodic) is below
+    ``cell_size`` is returned once; so are some farther pairs in adjacent cells.
+
+    Args:
+        positions: ``(N, 2)`` points inside the box.
+        cell_size: smallest cell side, e.g. the largest contact distance.
+        box: the box (its periodicity decides the minimum image).
+
+    Returns:
+        ``(i, j, d)``: int arrays ``(P,)`` with ``i != j`` and ``d`` ``(P, 2)``
+        the displacement from ``i`` to ``j``. O(N + P).
+
+    Example:
+        >>> import numpy as np
+        >>> from discsim import Box
+        >>> i, j, d = neighbour_pairs(np.array([[1.0, 1.0], [1.5, 1.0], [8.0, 8.0]]), 1.0, Box(10, 10))
+        >>> sorted(zip(i.tolist(), j.tolist()))
+        [(0, 1)]
+    """
+    n = len(positions)
+    empty = np.zeros(0, dtype=np.int64)
+    if n < 2:
+        return empty, empty, np.zeros((0, 2))
+    size = box.size
+    if box.periodic:
+        nx = max(1, int(box.width // cell_size))
+        ny = max(1, int(box.height // cell_size))
+        if nx < 3 or ny < 3:  # tiny periodic box: every pair is a candidate
+            nx = ny = 1
+    else:
+        nx = max(1, min(int(box.width // cell_size), 4096))
+        ny = max(1, min(int(box.height // cell_size), 4096))
+    cx = np.clip((positions[:, 0] * (nx / box.width)).astype(np.int64), 0, nx - 1)
+    cy = np.clip((positions[:, 1] * (ny / box.height)).astype(np.int64), 0, ny - 1)
+    cell = cx * ny + cy
+    order = np.argsort(cell, kind="stable")
+    sorted_cell = cell[order]
+    rank = np.empty(n, dtype=np.int64)
+    rank[order] = np.arange(n)
+    parts_i, parts_j = [], []
+    if nx * ny == 1:
+        ii, jj = np.triu_indices(n, 1)
+        parts_i.append(ii)
+        parts_j.append(jj)
+    else:
+        for dx, dy in ((0, 0), (1, 0), (1, 1), (0, 1), (-1, 1)):
+            ox, oy = cx + dx, cy + dy
+            if box.periodic:
+                ox, oy = ox % nx, oy % ny
+                valid = np.ones(n, dtype=bool)
+            else:
+                valid = (ox >= 0) & (ox < nx) & (oy < ny)
+            target = ox * ny + oy
+            start = np.searchsorted(sorted_cell, target, side="left")
+            stop = np.searchsorted(sorted_cell, target, side="right")
+            if dx == 0 and dy == 0:
+                start = rank + 1  # same cell: only later members, each pair once
+            count = np.where(valid, np.maximum(stop - start, 0), 0)
+            total = int(count.sum())
+            if total == 0:
+                continue
+            owner = np.repeat(np.arange(n), count)
+            first = np.repeat(start - (np.cumsum(count) - count), count)
+            parts_i.append(owner)
+            parts_j.append(order[first + np.arange(total)])
+    if not parts_i:
+        return empty, empty, np.zeros((0, 2))
+    i = np.concatenate(parts_i)
+    j = np.concatenate(parts_j)
+    d = positions[j] - positions[i]
+    if box.periodic:
+        d -= size * np.round(d / size)
+    return i, j, d
+
+
+def check_fits(discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE) -> None:
+    """Raise if a disc is outside ``box``, cut by a wall, or overlaps another.
+
+    Overlaps deeper than ``tolerance`` times the contact distance are errors;
+    touching discs are allowed. O(N) with a cell grid.
+
+    Raises:
+        OutsideBoxError: naming the disc, its position and radius.
+        OverlapError: naming the deepest overlapping pair and the depth.
+    """
+    pos, rad = discs.positions, discs.radii
+    if len(discs) == 0:
+        return
+    size = box.size
+    if box.periodic:
+        bad = ((pos < 0) | (pos >= size)).any(axis=1)
+        what = "outside the periodic box [0, width) x [0, height)"
+    else:
+        slack = tolerance * rad[:, None]
+        bad = ((pos - rad[:, None] < -slack) | (pos + rad[:, None] > size + slack)).any(axis=1)
+        what = "outside the box or cut by a wall"
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is {what} (box {box.width:g} x {box.height:g})"
+        raise OutsideBoxError(msg)
+    i, j, d = neighbour_pairs(pos, 2.0 * float(rad.max()), box)
+    contact = rad[i] + rad[j]
+    dist = np.hypot(d[:, 0], d[:, 1])
+    depth = contact - dist
+    bad = depth > tolerance * contact
+    if bad.any():
+        k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
+        msg = (
+            f"discs {int(i[k])} and {int(j[k])} overlap by {depth[k]:.6g} "
+            f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
+        )
+        raise OverlapError(msg)

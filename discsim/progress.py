@@ -1,0 +1,56 @@
+"""Progress bars for long runs: tqdm when installed, a plain stderr line otherwise."""
+
+from __future__ import annotations
+
+import sys
+import time
+from contextlib import contextmanager
+
+__all__ = ["progress_bar"]
+
+
+class _Bar:
+    """Wraps a tqdm bar (or prints plain lines) and shows collisions per second."""
+
+    def __init__(self, total, by_time: bool):
+        self._start = time.perf_counter()
+        self._collisions0 = None
+        self._by_time = by_time
+        try:
+            from tqdm.auto import tqdm
+        except ImportError:  # tqdm is optional: pip install "discsim[progress]"
+            self._tqdm = None
+            self._done = 0.0
+            self._total = total
+            self._last_print = 0.0
+        else:
+            unit = " time" if by_time else " events"
+            self._tqdm = tqdm(total=total, unit=unit, unit_scale=not by_time, dynamic_ncols=True, file=sys.stderr)
+
+    def update(self, amount, collisions: int) -> None:
+        if self._collisions0 is None:
+            self._collisions0 = collisions
+        elapsed = max(time.perf_counter() - self._start, 1e-9)
+        rate = (collisions - self._collisions0) / elapsed
+        if self._tqdm is not None:
+            self._tqdm.update(amount)
+            self._tqdm.set_postfix_str(f"{rate:,.0f} collisions/s", refresh=False)
+            return
+        self._done += amount
+        if elapsed - self._last_print >= 1.0:
+            self._last_print = elapsed
+            print(f"{self._done:.6g} / {self._total:.6g} ({rate:,.0f} collisions/s)", file=sys.stderr)
+
+    def close(self) -> None:
+        if self._tqdm is not None:
+            self._tqdm.close()
+
+
+@contextmanager
+def progress_bar(total, by_time: bool):
+    """A bar over ``total`` units of simulated time (``by_time``) or events."""
+    bar = _Bar(total, by_time)
+    try:
+        yield bar
+    finally:
+        bar.close()

@@ -1,0 +1,211 @@
+"""Validated input state: :class:`Discs` (struct of arrays) and :class:`Box`.
+
+Both classes check their input once, at construction, and are immutable
+afterwards; engines copy what they need and trust it. Checks that need both
+(inside the box, no overlaps) live in :func:`discsim.grid.check_fits`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from discsim.errors import InvalidDiscsError
+
+__all__ = ["Box", "Discs", "kinetic_energy", "momentum"]
+
+#: Relative tolerance on the contact distance below which two discs count as overlapping.
+OVERLAP_TOLERANCE = 1e-9
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
+
+
+def _as_float_array(name: str, value, shape: tuple[int, ...]) -> np.ndarray:
+    """Return ``value`` as a fresh float64 array of ``shape`` (scalars broadcast)."""
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        msg = f"{name} must be numeric, got {value!r}"
+        raise InvalidDiscsError(msg) from exc
+    if array.ndim == 0 and len(shape) == 1:
+        return np.full(shape, float(array))
+    if array.shape != shape:
+        msg = f"{name} must have shape {shape}, got shape {array.shape}"
+        raise InvalidDiscsError(msg)
+    return array
+
+
+def _first_bad(mask: np.ndarray) -> int:
+    return int(np.flatnonzero(mask.reshape(len(mask), -1).any(axis=1))[0])
+
+
+class Discs:
+    """A set of N discs as a struct of arrays, validated once.
+
+    Args:
+        positions: ``(N, 2)`` centres, in length units.
+        velocities: ``(N, 2)`` velocities, in length per time unit.
+        radii: ``(N,)`` radii, or one scalar for all; positive and finite.
+        masses: ``(N,)`` masses, or one scalar for all; positive; ``numpy.inf``
+            makes a fixed obstacle, whose velocity must be zero.
+        groups: ``(N,)`` integer collision-group labels (default all 0), used by
+            collision filters.
+
+    Attributes are read-only float64 arrays of the shapes above.
+
+    Raises:
+        InvalidDiscsError: on a wrong shape, a NaN or infinite position or
+            velocity, a non-positive radius or mass, or a moving obstacle; the
+            message names the first offending disc and its value.
+
+    Example:
+        >>> import discsim as ds
+        >>> discs = ds.Discs([[1.0, 1.0], [3.0, 1.0]], [[1.0, 0.0], [0.0, 0.0]], radii=0.5)
+        >>> len(discs), discs.radii.tolist()
+        (2, [0.5, 0.5])
+    """
+
+    def __init__(self, positions, velocities, radii, masses=1.0, groups=None):
+        pos = np.array(positions, dtype=np.float64)
+        if pos.ndim != 2 or pos.shape[1] != 2:
+            msg = f"positions must have shape (N, 2), got shape {pos.shape}"
+            raise InvalidDiscsError(msg)
+        n = pos.shape[0]
+        vel = _as_float_array("velocities", velocities, (n, 2))
+        rad = _as_float_array("radii", radii, (n,))
+        mass = _as_float_array("masses", masses, (n,))
+        for name, arr in (("position", pos), ("velocity", vel)):
+            bad = ~np.isfinite(arr)
+            if bad.any():
+                i = _first_bad(bad)
+                msg = f"disc {i} has a non-finite {name} {arr[i].tolist()}"
+                raise InvalidDiscsError(msg)
+        bad = ~(np.isfinite(rad) & (rad > 0))
+        if bad.any():
+            i = _first_bad(bad)
+            msg = f"disc {i} has radius {rad[i]!r}; radii must be positive and finite"
+            raise InvalidDiscsError(msg)
+        bad = ~(mass > 0)  # also catches NaN
+        if bad.any():
+            i = _first_bad(bad)
+            msg = f"disc {i} has mass {mass[i]!r}; masses must be positive (numpy.inf for an obstacle)"
+            raise InvalidDiscsError(msg)
+        moving_obstacle = np.isinf(mass) & (vel != 0).any(axis=1)
+        if moving_obstacle.any():
+            i = _first_bad(moving_obstacle)
+            msg = f"disc {i} has infinite mass but velocity {vel[i].tolist()}; obstacles must be at rest"
+            raise InvalidDiscsError(msg)
+        if groups is None:
+            grp = np.zeros(n, dtype=np.int64)
+        else:
+            grp = np.array(groups)
+            if grp.ndim == 0:
+                grp = np.full(n, grp)
+            if grp.shape != (n,) or not np.issubdtype(grp.dtype, np.integer):
+                msg = f"groups must be ({n},) integers, got shape {grp.shape} dtype {grp.dtype}"
+                raise InvalidDiscsError(msg)
+            grp = grp.astype(np.int64)
+        self.positions = _readonly(pos)
+        self.velocities = _readonly(vel)
+        self.radii = _readonly(rad)
+        self.masses = _readonly(mass)
+        self.groups = _readonly(grp)
+
+    def __len__(self) -> int:
+        return len(self.radii)
+
+    def __repr__(self) -> str:
+        return f"Discs(n={len(self)}, radii in [{self.radii.min(initial=0):g}, {self.radii.max(initial=0):g}])"
+
+    def replace(self, positions=None, velocities=None) -> Discs:
+        """Return new validated discs with other positions and/or velocities."""
+        return Discs(
+            self.positions if positions is None else positions,
+            self.velocities if velocities is None else velocities,
+            self.radii,
+            self.masses,
+            self.groups,
+        )
+
+    def kinetic_energy(self) -> float:
+        """Total kinetic energy ``sum(m v^2 / 2)`` (obstacles contribute zero)."""
+        return kinetic_energy(self.velocities, self.masses)
+
+    def momentum(self) -> np.ndarray:
+        """Total momentum ``(2,)`` of the moving discs (obstacles excluded)."""
+        return momentum(self.velocities, self.masses)
+
+
+def kinetic_energy(velocities: np.ndarray, masses: np.ndarray) -> float:
+    """Sum of ``m v^2 / 2`` over discs of finite mass."""
+    finite = np.isfinite(masses)
+    v2 = np.einsum("ij,ij->i", velocities[finite], velocities[finite])
+    return float(0.5 * np.dot(masses[finite], v2))
+
+
+def momentum(velocities: np.ndarray, masses: np.ndarray) -> np.ndarray:
+    """Sum of ``m v`` over discs of finite mass, shape ``(2,)``."""
+    finite = np.isfinite(masses)
+    return masses[finite] @ velocities[finite]
+
+
+@dataclass(frozen=True)
+class Box:
+    """The rectangle ``[0, width] x [0, height]`` that holds the discs.
+
+    Args:
+        width: extent in x (length units), positive and finite.
+        height: extent in y (length units), positive and finite.
+        periodic: if True the box wraps in x and y (minimum image); otherwise
+            its four sides are reflecting walls.
+
+    Example:
+        >>> Box(10.0, 5.0).area
+        50.0
+    """
+
+    width: float
+    height: float
+    periodic: bool = False
+
+    def __post_init__(self):
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            try:
+                value = float(value)
+            except (TypeError, ValueError) as exc:
+                msg = f"box {name} must be a number, got {value!r}"
+                raise InvalidDiscsError(msg) from exc
+            if not (math.isfinite(value) and value > 0):
+                msg = f"box {name} must be positive and finite, got {value!r}"
+                raise InvalidDiscsError(msg)
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "periodic", bool(self.periodic))
+
+    @property
+    def area(self) -> float:
+        """Area ``width * height``."""
+        return self.width * self.height
+
+    @property
+    def size(self) -> np.ndarray:
+        """``(2,)`` array ``[width, height]``."""
+        return np.array([self.width, self.height])
+
+    def wrap(self, positions: np.ndarray) -> np.ndarray:
+        """Map positions into the box when periodic; return them unchanged otherwise."""
+        if not self.periodic:
+            return positions
+        return np.mod(positions, self.size)
+
+    def displacement(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``b - a``, with the minimum-image convention when periodic."""
+        d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
+        if self.periodic:
+            d = d - self.size * np.round(d / self.size)
+        return d

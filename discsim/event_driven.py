@@ -52,7 +52,7 @@ class EventDriven(Engine):
         queue: ``"sorted"`` (a ``sortedcontainers.SortedList``, the default) or
             ``"heap"`` (``heapq`` with lazy deletion).
         cell_size: side of the grid cells; default the largest disc diameter,
-            grown where needed so that there are at most ``2 N + 9`` cells.
+            grown where needed so that there are at most ``4 N + 9`` cells.
             Never below the largest diameter.
 
     Raises:
@@ -90,7 +90,7 @@ class EventDriven(Engine):
         n = len(discs)
         diameter = 2.0 * float(discs.radii.max()) if n else 1.0
         if cell_size is None:
-            grid = CellGrid(box, diameter, max_cells=2 * n + 9)
+            grid = CellGrid(box, diameter, max_cells=4 * n + 9)
         else:
             if not cell_size >= diameter:
                 msg = f"cell_size {cell_size!r} is below the largest disc diameter {diameter!r}"
@@ -115,8 +115,9 @@ class EventDriven(Engine):
         self._log = EventLog()
         self._virial = 0.0
         self._last = None
-        self.counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0, "predictions": 0}
+        self._counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0}
         self.max_queue = 0
+        self._predict, self._predict_after_crossing, self._predictions = self._make_predictor()
         for i in range(n):
             if self._moving[i]:
                 self._predict(i, 0.0, -1)
@@ -139,6 +140,11 @@ class EventDriven(Engine):
 
     def _event_array(self) -> np.ndarray:
         return self._log.to_array()
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """Events so far: ``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
+        return {**self._counts, "predictions": self._predictions()}
 
     @property
     def queue_size(self) -> int:
@@ -224,83 +230,168 @@ class EventDriven(Engine):
         return Event(t, KIND_NAMES[kind], i, j)
 
     # --- prediction ------------------------------------------------------------------
-    def _predict(self, i: int, t: float, exclude: int) -> None:
-        """Schedule disc ``i``'s earliest event after time ``t`` (never with ``exclude``).
+    def _make_predictor(self):
+        """Build the prediction closures over the state lists (closures read locals fast).
 
-        The 3x3 neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
+        Returns ``(predict, predict_after_crossing, predictions)``:
+
+        - ``predict(i, t, exclude)`` schedules disc ``i``'s earliest event after
+          time ``t``: its wall hit, its cell crossing, or its collision with a
+          disc in the 3x3 block of cells around it, never with ``exclude`` (the
+          partner it has just left: roundoff must not make a pair collide
+          twice). The earliest collision found is also kept per disc.
+        - ``predict_after_crossing(i, t, direction)`` does the same after ``i``
+          entered a new cell, looking only at the 3 cells that just became
+          adjacent and taking the kept collision for the 6 that stay adjacent.
+          That equals a full 3x3 re-prediction as long as the kept partner has
+          not changed course since; otherwise it falls back to ``predict``.
+        - ``predictions()`` counts the predictions made.
+
+        The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
         """
         rx, ry, vx, vy, tr, radius = self._rx, self._ry, self._vx, self._vy, self._tr, self._radius
-        grid = self.grid
-        vxi, vyi = vx[i], vy[i]
-        dti = t - tr[i]
-        xi = rx[i] + vxi * dti
-        yi = ry[i] + vyi * dti
-        ri = radius[i]
-        c = self._cell[i]
-        cx, cy = divmod(c, grid.ny)
-        periodic = self.box.periodic
-        best, kind, other = INF, _CROSSING, 0
-        # Cell crossings and walls.
-        if vxi > 0.0:
-            if periodic or cx < grid.nx - 1:
-                best, other = ((cx + 1) * grid.lx - xi) / vxi, _PLUS_X
-            elif not periodic:
-                best, kind, other = (self.box.width - ri - xi) / vxi, _WALL, 0
-        elif vxi < 0.0:
-            if periodic or cx > 0:
-                best, other = (cx * grid.lx - xi) / vxi, _MINUS_X
-            elif not periodic:
-                best, kind, other = (ri - xi) / vxi, _WALL, 0
-        if vyi > 0.0:
-            if periodic or cy < grid.ny - 1:
-                ty, ky, oy = ((cy + 1) * grid.ly - yi) / vyi, _CROSSING, _PLUS_Y
-            else:
-                ty, ky, oy = (self.box.height - ri - yi) / vyi, _WALL, 1
-            if ty < best:
-                best, kind, other = ty, ky, oy
-        elif vyi < 0.0:
-            if periodic or cy > 0:
-                ty, ky, oy = (cy * grid.ly - yi) / vyi, _CROSSING, _MINUS_Y
-            else:
-                ty, ky, oy = (ri - yi) / vyi, _WALL, 1
-            if ty < best:
-                best, kind, other = ty, ky, oy
-        if best < 0.0:
-            best = 0.0
-        # Collisions with discs in the 3x3 block of cells.
-        cells = self._cells
+        cell, count = self._cell, self._count
+        grid, box = self.grid, self.box
+        nobody: list[int] = []  # stands for the cells a wall cuts off
+        blocks = [tuple(self._cells[c2] if c2 >= 0 else nobody for c2 in grid.neighbours[c]) for c in range(len(grid))]
+        shifts = grid.shifts
+        whole_block = range(9)
+        front = {_PLUS_X: (6, 7, 8), _MINUS_X: (0, 1, 2), _PLUS_Y: (2, 5, 8), _MINUS_Y: (0, 3, 6)}
+        width, height, periodic = box.width, box.height, box.periodic
+        # Per-cell boundaries, and whether a wall stands beyond each side.
+        xlo, xhi, ylo, yhi, wall_xlo, wall_xhi, wall_ylo, wall_yhi = ([] for _ in range(8))
+        for c in range(len(grid)):
+            cx, cy = divmod(c, grid.ny)
+            xlo.append(cx * grid.lx)
+            xhi.append(width if cx == grid.nx - 1 else (cx + 1) * grid.lx)
+            ylo.append(cy * grid.ly)
+            yhi.append(height if cy == grid.ny - 1 else (cy + 1) * grid.ly)
+            wall_xlo.append(not periodic and cx == 0)
+            wall_xhi.append(not periodic and cx == grid.nx - 1)
+            wall_ylo.append(not periodic and cy == 0)
+            wall_yhi.append(not periodic and cy == grid.ny - 1)
+        n = len(rx)
+        kept_time, kept_partner, kept_stamp = [INF] * n, [-1] * n, [0] * n
+        push, discard = self._queue.push, self._queue.discard
         sqrt = math.sqrt
-        for c2, (sx, sy) in zip(grid.neighbours[c], grid.shifts[c]):
-            for j in cells[c2]:
-                if j == i or j == exclude:
+        n_pred = 0
+
+        def scan(i, t, exclude, xi, yi, vxi, vyi, ri, c, slots):
+            """Earliest collision ``(dt, partner)`` of ``i`` with the discs in ``slots`` of its block."""
+            best, partner = INF, -1
+            block, shift = blocks[c], shifts[c]
+            for k in slots:
+                members = block[k]
+                if not members:
                     continue
-                dvx = vx[j] - vxi
-                dvy = vy[j] - vyi
-                dtj = t - tr[j]
-                dx = rx[j] + vx[j] * dtj + sx - xi
-                dy = ry[j] + vy[j] * dtj + sy - yi
-                b = dx * dvx + dy * dvy
-                if b >= 0.0:
-                    continue
-                s = ri + radius[j]
-                cc = dx * dx + dy * dy - s * s
-                if cc <= 0.0:
-                    tij = 0.0
-                else:
-                    a = dvx * dvx + dvy * dvy
-                    disc = b * b - a * cc
-                    if disc <= 0.0:
+                sx, sy = shift[k]
+                for j in members:
+                    if j == i or j == exclude:
                         continue
-                    tij = cc / (-b + sqrt(disc))
-                if tij < best:
-                    best, kind, other = tij, _COLLISION, j
-        self.counts["predictions"] += 1
-        if best == INF:
-            self._queue.discard(i)
-        elif kind == _COLLISION:
-            self._queue.push(i, t + best, (_COLLISION, other, self._count[other]))
-        else:
-            self._queue.push(i, t + best, (kind, other, 0))
+                    dvx = vx[j] - vxi
+                    dvy = vy[j] - vyi
+                    dtj = t - tr[j]
+                    dx = rx[j] + vx[j] * dtj + sx - xi
+                    dy = ry[j] + vy[j] * dtj + sy - yi
+                    b = dx * dvx + dy * dvy
+                    if b >= 0.0:
+                        continue
+                    s = ri + radius[j]
+                    cc = dx * dx + dy * dy - s * s
+                    if cc <= 0.0:
+                        tij = 0.0
+                    else:
+                        a = dvx * dvx + dvy * dvy
+                        disc = b * b - a * cc
+                        if disc <= 0.0:
+                            continue
+                        tij = cc / (-b + sqrt(disc))
+                    if tij < best:
+                        best, partner = tij, j
+            return best, partner
+
+        def schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner):
+            """Push the earlier of the collision at absolute ``t_hit`` and the next wall or crossing."""
+            best, kind, other = INF, _CROSSING, 0
+            if vxi > 0.0:
+                if wall_xhi[c]:
+                    best, kind = (width - ri - xi) / vxi, _WALL
+                else:
+                    best, other = (xhi[c] - xi) / vxi, _PLUS_X
+            elif vxi < 0.0:
+                if wall_xlo[c]:
+                    best, kind = (ri - xi) / vxi, _WALL
+                else:
+                    best, other = (xlo[c] - xi) / vxi, _MINUS_X
+            if vyi > 0.0:
+                if wall_yhi[c]:
+                    ty = (height - ri - yi) / vyi
+                    if ty < best:
+                        best, kind, other = ty, _WALL, 1
+                else:
+                    ty = (yhi[c] - yi) / vyi
+                    if ty < best:
+                        best, kind, other = ty, _CROSSING, _PLUS_Y
+            elif vyi < 0.0:
+                if wall_ylo[c]:
+                    ty = (ri - yi) / vyi
+                    if ty < best:
+                        best, kind, other = ty, _WALL, 1
+                else:
+                    ty = (ylo[c] - yi) / vyi
+                    if ty < best:
+                        best, kind, other = ty, _CROSSING, _MINUS_Y
+            if best < 0.0:
+                best = 0.0
+            t_best = t + best
+            if t_hit <= t_best and partner >= 0:
+                push(i, t_hit, (_COLLISION, partner, count[partner]))
+            elif best == INF:
+                discard(i)
+            else:
+                push(i, t_best, (kind, other, 0))
+
+        def predict(i: int, t: float, exclude: int) -> None:
+            nonlocal n_pred
+            n_pred += 1
+            vxi, vyi = vx[i], vy[i]
+            dti = t - tr[i]
+            xi = rx[i] + vxi * dti
+            yi = ry[i] + vyi * dti
+            ri = radius[i]
+            c = cell[i]
+            dt_hit, partner = scan(i, t, exclude, xi, yi, vxi, vyi, ri, c, whole_block)
+            t_hit = t + dt_hit
+            kept_time[i], kept_partner[i] = t_hit, partner
+            if partner >= 0:
+                kept_stamp[i] = count[partner]
+            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner)
+
+        def predict_after_crossing(i: int, t: float, direction: int) -> None:
+            nonlocal n_pred
+            partner = kept_partner[i]
+            if partner >= 0 and count[partner] != kept_stamp[i]:
+                predict(i, t, -1)
+                return
+            n_pred += 1
+            vxi, vyi = vx[i], vy[i]
+            dti = t - tr[i]
+            xi = rx[i] + vxi * dti
+            yi = ry[i] + vyi * dti
+            ri = radius[i]
+            c = cell[i]
+            dt_new, new_partner = scan(i, t, -1, xi, yi, vxi, vyi, ri, c, front[direction])
+            t_hit = kept_time[i]
+            if t + dt_new < t_hit:
+                t_hit = t + dt_new
+                partner = new_partner
+                kept_time[i], kept_partner[i], kept_stamp[i] = t_hit, partner, count[partner]
+            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner)
+
+        def predictions() -> int:
+            return n_pred
+
+        return predict, predict_after_crossing, predictions
 
     # --- the hot loop ----------------------------------------------------------------
     def _process(self, until: float, limit: int) -> int:
@@ -309,21 +400,24 @@ class EventDriven(Engine):
         Returns the number of physical events (collisions plus wall hits) processed.
         """
         queue = self._queue
-        pop, peek = queue.pop, queue.peek
-        predict = self._predict
+        pop_before = queue.pop_before
+        predict, predict_after_crossing = self._predict, self._predict_after_crossing
         rx, ry, vx, vy, tr = self._rx, self._ry, self._vx, self._vy, self._tr
         count, mass, moving = self._count, self._mass, self._moving
         cell, cells, grid = self._cell, self._cells, self.grid
         nx, ny = grid.nx, grid.ny
         width, height, periodic = self.box.width, self.box.height, self.box.periodic
         log = self._log if self.record else None
-        counts = self.counts
+        counts = self._counts
         n_coll = n_wall = n_cross = n_stale = 0
         done = 0
         max_queue = self.max_queue
         now, last, virial = self.time, None, self._virial
-        while done != limit and peek() <= until:
-            t, i, (kind, other, stamp) = pop()
+        while done != limit:
+            popped = pop_before(until)
+            if popped is None:
+                break
+            t, i, (kind, other, stamp) = popped
             if kind == _COLLISION:
                 j = other
                 if count[j] != stamp:  # the partner has changed course since the prediction
@@ -401,7 +495,7 @@ class EventDriven(Engine):
                 cell[i] = c
                 cells[c].append(i)
                 n_cross += 1
-                predict(i, t, -1)
+                predict_after_crossing(i, t, other)
             now = t
             size = len(queue)
             if size > max_queue:

@@ -45,8 +45,11 @@ class CellGrid:
 
     Attributes:
         nx, ny (int): cells along x and y. ``lx, ly`` (float): cell sides.
-        neighbours (list[tuple[int, ...]]): for each cell, the distinct cells of
-            its 3x3 block (itself included).
+        neighbours (list[tuple[int, ...]]): for each cell, the 9 cells of its 3x3
+            block in the order ``(dx, dy)`` for ``dx`` in (-1, 0, 1) for ``dy`` in
+            (-1, 0, 1) (itself at position 4); -1 where a wall cuts the block off.
+            Entries 6-8 are the block's column on the +x side, 0-2 on the -x
+            side, 2, 5, 8 on the +y side and 0, 3, 6 on the -y side.
         shifts (list[tuple[tuple[float, float], ...]]): for each cell, one
             ``(sx, sy)`` per neighbour: the offset to add to a neighbour's
             position to get its image next to the cell (zero except across a
@@ -99,27 +102,17 @@ class CellGrid:
             for cy in range(ny):
                 cells, offs = [], []
                 for dx in (-1, 0, 1):
-                    ox, sx = cx + dx, 0.0
-                    if periodic:
-                        if ox < 0:
-                            ox, sx = ox + nx, -width
-                        elif ox >= nx:
-                            ox, sx = ox - nx, width
-                    elif not 0 <= ox < nx:
-                        continue
                     for dy in (-1, 0, 1):
-                        oy, sy = cy + dy, 0.0
+                        ox, oy, sx, sy = cx + dx, cy + dy, 0.0, 0.0
                         if periodic:
-                            if oy < 0:
-                                oy, sy = oy + ny, -height
-                            elif oy >= ny:
-                                oy, sy = oy - ny, height
-                        elif not 0 <= oy < ny:
+                            ox, oy = ox % nx, oy % ny
+                            sx = width * ((cx + dx) // nx)
+                            sy = height * ((cy + dy) // ny)
+                        elif not (0 <= ox < nx and 0 <= oy < ny):
+                            cells.append(-1)
+                            offs.append((0.0, 0.0))
                             continue
-                        cell = ids[ox * ny + oy]
-                        if cell in cells:
-                            continue
-                        cells.append(cell)
+                        cells.append(ids[ox * ny + oy])
                         offs.append((sx, sy))
                 neighbours.append(tuple(cells))
                 offs = tuple(offs)

@@ -36,19 +36,30 @@ class EventQueue:
 
     def __init__(self, n_owners: int):
         self._keys = SortedList()
+        self._add, self._remove = self._keys.add, self._keys.remove
         self._time = [math.inf] * n_owners
         self._payload: list = [None] * n_owners
 
     def push(self, owner: int, time: float, payload) -> None:
         """Schedule ``payload`` for ``owner`` at ``time``, replacing its pending event."""
         old = self._time[owner]
-        keys = self._keys
         if old != math.inf:
-            keys.remove((old, owner))
+            self._remove((old, owner))
         if time != math.inf:
-            keys.add((time, owner))
+            self._add((time, owner))
         self._time[owner] = time
         self._payload[owner] = payload
+
+    def pop_before(self, until: float):
+        """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
+        keys = self._keys
+        if not keys or keys[0][0] > until:
+            return None
+        time, owner = keys.pop(0)
+        self._time[owner] = math.inf
+        payload = self._payload[owner]
+        self._payload[owner] = None
+        return time, owner, payload
 
     def pop(self) -> tuple[float, int, object]:
         """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""
@@ -132,6 +143,21 @@ class HeapEventQueue:
         heap, version = self._heap, self._version
         while heap and heap[0][2] != version[heap[0][1]]:
             heapq.heappop(heap)
+
+    def pop_before(self, until: float):
+        """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
+        heap, version = self._heap, self._version
+        while heap and heap[0][2] != version[heap[0][1]]:
+            heapq.heappop(heap)
+        if not heap or heap[0][0] > until:
+            return None
+        time, owner, _ = heapq.heappop(heap)
+        self._time[owner] = math.inf
+        version[owner] += 1
+        self._live -= 1
+        payload = self._payload[owner]
+        self._payload[owner] = None
+        return time, owner, payload
 
     def pop(self) -> tuple[float, int, object]:
         """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""

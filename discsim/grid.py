@@ -231,7 +231,7 @@ def check_fits(discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE) -> 
     if bad.any():
         k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
         msg = (
-            f"discs {int(i[k])} and {int(j[k])} overlap by {depth[k]:.6g} "
+            f"discs {min(int(i[k]), int(j[k]))} and {max(int(i[k]), int(j[k]))} overlap by {depth[k]:.6g} "
             f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
         )
         raise OverlapError(msg)

@@ -88,12 +88,12 @@ class Discs:
         bad = ~(np.isfinite(rad) & (rad > 0))
         if bad.any():
             i = _first_bad(bad)
-            msg = f"disc {i} has radius {rad[i]!r}; radii must be positive and finite"
+            msg = f"disc {i} has radius {float(rad[i])!r}; radii must be positive and finite"
             raise InvalidDiscsError(msg)
         bad = ~(mass > 0)  # also catches NaN
         if bad.any():
             i = _first_bad(bad)
-            msg = f"disc {i} has mass {mass[i]!r}; masses must be positive (numpy.inf for an obstacle)"
+            msg = f"disc {i} has mass {float(mass[i])!r}; masses must be positive (numpy.inf for an obstacle)"
             raise InvalidDiscsError(msg)
         moving_obstacle = np.isinf(mass) & (vel != 0).any(axis=1)
         if moving_obstacle.any():

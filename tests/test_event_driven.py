@@ -1,0 +1,209 @@
+"""The event-driven engine on cases with exact answers, and its public protocol."""
+
+import math
+
+import numpy as np
+import pytest
+
+import discsim as ds
+
+
+def _two(p1, v1, p2, v2, r=(1.0, 1.0), m=(1.0, 1.0), box=(20.0, 20.0)):
+    discs = ds.Discs([p1, p2], [v1, v2], list(r), list(m))
+    return ds.EventDriven(discs, ds.Box(*box))
+
+
+def test_head_on_unequal_masses():
+    m1, m2, u = 3.0, 1.0, 2.0
+    sim = _two([5.0, 10.0], [u, 0.0], [12.0, 10.0], [0.0, 0.0], m=(m1, m2))
+    event = sim.step()
+    assert event.kind == "collision" and {event.i, event.j} == {0, 1}
+    assert event.time == pytest.approx(5.0 / u, rel=1e-15)  # gap 7 - 2 closes at speed 2
+    v = sim.velocities
+    assert v[:, 0] == pytest.approx([(m1 - m2) * u / (m1 + m2), 2 * m1 * u / (m1 + m2)], rel=1e-15)
+    assert np.all(v[:, 1] == 0.0)
+    assert sim.positions[1, 0] - sim.positions[0, 0] == pytest.approx(2.0, rel=1e-15)
+
+
+@pytest.mark.parametrize("offset", [0.3, 1.0, 1.7])
+def test_equal_masses_oblique_leave_at_right_angles(offset):
+    sim = _two([3.0, 10.0], [1.5, 0.0], [10.0, 10.0 + offset], [0.0, 0.0])
+    sim.step()
+    v1, v2 = sim.velocities
+    assert np.dot(v1, v2) == pytest.approx(0.0, abs=1e-14)
+    assert np.hypot(*v1) ** 2 + np.hypot(*v2) ** 2 == pytest.approx(1.5**2, rel=1e-14)
+    # the struck disc leaves along the line of centres at contact
+    d = sim.positions[1] - sim.positions[0]
+    assert d[0] * v2[1] - d[1] * v2[0] == pytest.approx(0.0, abs=1e-13)
+
+
+def _unfold(x0, v, t, lo, hi):
+    """Closed-form position of a point bouncing between lo and hi: fold the free path."""
+    span = hi - lo
+    s = np.mod(x0 - lo + v * t, 2 * span)
+    return lo + np.where(s > span, 2 * span - s, s)
+
+
+def test_single_disc_in_a_box_follows_the_unfolded_path():
+    r, w, h = 0.5, 7.0, 3.0
+    p0, v0 = np.array([2.0, 1.0]), np.array([3.1, 1.7])
+    sim = ds.EventDriven(ds.Discs([p0], [v0], r), ds.Box(w, h))
+    times = np.linspace(0.0, 40.0, 401)
+    sim.run(until=times[-1])
+    expect_x = _unfold(p0[0], v0[0], times, r, w - r)
+    expect_y = _unfold(p0[1], v0[1], times, r, h - r)
+    path = sim.trajectory(times)[:, 0, :]
+    assert path[:, 0] == pytest.approx(expect_x, abs=1e-11)
+    assert path[:, 1] == pytest.approx(expect_y, abs=1e-11)
+    # wall hits: the number of times each coordinate reached a wall
+    hits_x = math.floor((p0[0] - r + v0[0] * 40.0) / (w - 2 * r))
+    hits_y = math.floor((p0[1] - r + v0[1] * 40.0) / (h - 2 * r))
+    assert sim.counts["wall_hits"] == hits_x + hits_y
+    assert sim.counts["collisions"] == 0
+    assert sim.positions[0] == pytest.approx([expect_x[-1], expect_y[-1]], abs=1e-11)
+
+
+@pytest.mark.parametrize("n", [3, 5, 8])
+def test_newtons_cradle_passes_momentum_down_the_line(n):
+    r = 1.0
+    pos = [[2.0, 5.0]] + [[6.0 + 2 * r * k, 5.0] for k in range(n - 1)]
+    vel = [[1.0, 0.0]] + [[0.0, 0.0]] * (n - 1)
+    sim = ds.EventDriven(ds.Discs(pos, vel, r), ds.Box(6.0 + 2 * r * n + 10.0, 10.0))
+    sim.run(until=4.0)  # the striker arrives at t = 2; the far disc has not reached the wall yet
+    v = sim.velocities
+    assert sim.counts["collisions"] == n - 1
+    assert v[-1] == pytest.approx([1.0, 0.0], abs=1e-12)
+    assert np.abs(v[:-1]).max() < 1e-12
+    assert sim.momentum() == pytest.approx([1.0, 0.0], abs=1e-12)
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.4, -1.1])
+def test_infinite_mass_obstacle_reflects_like_a_mirror(angle):
+    n = np.array([math.cos(angle), math.sin(angle)])
+    obstacle = np.array([10.0, 10.0])
+    v0 = np.array([2.0, 0.7])
+    # start the disc so that it touches the obstacle at t = 1 at contact direction n
+    contact = obstacle - 3.0 * n
+    start = contact - v0
+    assert np.dot(v0, n) > 0  # approaching for each angle above
+    discs = ds.Discs([start, obstacle], [v0, [0.0, 0.0]], [1.0, 2.0], [1.0, np.inf])
+    sim = ds.EventDriven(discs, ds.Box(20.0, 20.0))
+    event = sim.step()
+    assert event.time == pytest.approx(1.0, rel=1e-12)
+    mirrored = v0 - 2 * np.dot(v0, n) * n
+    assert sim.velocities[0] == pytest.approx(mirrored, abs=1e-13)
+    assert np.all(sim.velocities[1] == 0.0)
+    sim.run(until=5.0)
+    assert sim.positions[1] == pytest.approx(obstacle, abs=0)  # never moves
+
+
+def test_run_until_sets_time_and_run_events_counts_physical_events():
+    discs, box = ds.random_gas(100, 0.3, seed=5)
+    sim = ds.EventDriven(discs, box).run(until=3.0)
+    assert sim.time == 3.0
+    n0 = sim.counts["collisions"] + sim.counts["wall_hits"]
+    sim.run(events=250)
+    assert sim.counts["collisions"] + sim.counts["wall_hits"] == n0 + 250
+    assert sim.time == sim.events["time"][-1]
+    assert sim.run(until=sim.time) is sim  # until == now is a no-op
+    with pytest.raises(ds.TimeError, match="before the current time"):
+        sim.run(until=1.0)
+    with pytest.raises(ValueError, match="until"):
+        sim.run()
+
+
+def test_step_returns_events_in_time_order_and_none_when_nothing_moves():
+    discs, box = ds.random_gas(50, 0.3, seed=2)
+    sim = ds.EventDriven(discs, box)
+    times = [sim.step().time for _ in range(100)]
+    assert times == sorted(times)
+    still = ds.EventDriven(ds.Discs([[1.0, 1.0]], [[0.0, 0.0]], 0.5), ds.Box(4, 4))
+    assert still.step() is None
+
+
+def test_same_input_gives_the_same_events_bit_for_bit():
+    discs, box = ds.random_gas(300, 0.5, seed=11)
+    a = ds.EventDriven(discs, box).run(until=5.0)
+    b = ds.EventDriven(discs, box).run(until=5.0)
+    assert a.events.tobytes() == b.events.tobytes()
+    assert np.array_equal(a.positions, b.positions)
+
+
+@pytest.mark.parametrize("queue", ["sorted", "heap"])
+def test_stopping_halfway_changes_nothing(queue):
+    discs, box = ds.random_gas(300, 0.5, seed=12, periodic=False)
+    whole = ds.EventDriven(discs, box, queue=queue).run(until=6.0)
+    halves = ds.EventDriven(discs, box, queue=queue).run(until=3.0).run(until=6.0)
+    assert whole.events.tobytes() == halves.events.tobytes()
+    assert np.array_equal(whole.positions, halves.positions)
+    assert np.array_equal(whole.velocities, halves.velocities)
+
+
+def test_heap_and_sorted_queues_give_the_same_events():
+    discs, box = ds.random_gas(200, 0.4, seed=13)
+    a = ds.EventDriven(discs, box, queue="sorted").run(until=4.0)
+    b = ds.EventDriven(discs, box, queue="heap").run(until=4.0)
+    assert a.events.tobytes() == b.events.tobytes()
+
+
+def test_trajectory_reproduces_the_engine_state_at_any_time():
+    discs, box = ds.random_gas(80, 0.4, seed=3)
+    sim = ds.EventDriven(discs, box)
+    checkpoints = [0.0, 0.7, 1.3, 2.9, 4.0]
+    snapshots = []
+    for t in checkpoints:
+        sim.run(until=t)
+        snapshots.append(sim.positions)
+    rebuilt = sim.trajectory(checkpoints)
+    assert rebuilt.shape == (len(checkpoints), 80, 2)
+    for got, want in zip(rebuilt, snapshots):
+        assert np.abs(box.displacement(got, want)).max() < 1e-9
+    with pytest.raises(ds.TimeError, match="outside the simulated span"):
+        sim.trajectory([5.0])
+
+
+def test_event_log_records_state_after_each_event():
+    sim = _two([5.0, 10.0], [2.0, 0.0], [12.0, 10.0], [0.0, 0.0], m=(3.0, 1.0))
+    sim.run(until=10.0)
+    ev = sim.events
+    assert ev["kind"][0] == 0 and (ev["i"][0], ev["j"][0]) in {(0, 1), (1, 0)}
+    first = ev[0]
+    assert first["time"] == pytest.approx(2.5)
+    vel = {int(first["i"]): first["vxi"], int(first["j"]): first["vxj"]}
+    assert vel[0] == pytest.approx(1.0) and vel[1] == pytest.approx(3.0)
+    walls = ev[ev["kind"] == 1]
+    assert len(walls) == sim.counts["wall_hits"] and np.all(walls["j"] == -1)
+
+
+def test_recording_off_keeps_no_log():
+    discs, box = ds.random_gas(100, 0.3, seed=1)
+    sim = ds.EventDriven(discs, box, record=False).run(until=3.0)
+    assert len(sim.events) == 0 and sim.counts["collisions"] > 0
+    with pytest.raises(ValueError, match="record=True"):
+        sim.trajectory([1.0])
+
+
+def test_queue_holds_at_most_one_event_per_disc():
+    discs, box = ds.random_gas(500, 0.6, seed=4)
+    sim = ds.EventDriven(discs, box, record=False).run(events=20_000)
+    assert sim.max_queue <= 500
+    sim._check()
+
+
+def test_energy_and_momentum_are_conserved_to_roundoff():
+    discs, box = ds.random_gas(400, 0.5, seed=6)
+    sim = ds.EventDriven(discs, box, record=False)
+    e0, p0 = sim.kinetic_energy(), sim.momentum()
+    sim.run(events=20_000)
+    assert abs(sim.kinetic_energy() - e0) / e0 < 1e-12
+    assert np.abs(sim.momentum() - p0).max() < 1e-10
+
+
+def test_progress_bar_runs(capsys):
+    discs, box = ds.random_gas(100, 0.3, seed=1)
+    a = ds.EventDriven(discs, box).run(until=2.0, progress=True)
+    b = ds.EventDriven(discs, box).run(until=2.0)
+    assert a.events.tobytes() == b.events.tobytes()
+    assert a.time == b.time == 2.0
+    c = ds.EventDriven(discs, box).run(events=500, progress=True)
+    assert c.counts["collisions"] + c.counts["wall_hits"] == 500

@@ -1,0 +1,117 @@
+"""Bad input: a clear error naming the disc and the value, raised before any change."""
+
+import numpy as np
+import pytest
+
+import discsim as ds
+
+
+def _ok():
+    return dict(positions=[[1.0, 1.0], [4.0, 1.0], [1.0, 4.0]], velocities=np.zeros((3, 2)), radii=0.5)
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "match"),
+    [
+        ({"positions": [[1.0, 1.0, 0.0]]}, ds.InvalidDiscsError, r"shape \(N, 2\), got shape \(1, 3\)"),
+        ({"velocities": np.zeros((2, 2))}, ds.InvalidDiscsError, r"velocities must have shape \(3, 2\)"),
+        ({"radii": [0.5, 0.5]}, ds.InvalidDiscsError, r"radii must have shape \(3,\)"),
+        ({"positions": [[1.0, 1.0], [np.nan, 1.0], [1.0, 4.0]]}, ds.InvalidDiscsError, "disc 1 has a non-finite position"),
+        ({"velocities": [[0, 0], [0, 0], [np.inf, 0]]}, ds.InvalidDiscsError, "disc 2 has a non-finite velocity"),
+        ({"radii": [0.5, -1.0, 0.5]}, ds.InvalidDiscsError, r"disc 1 has radius -1\.0"),
+        ({"radii": [0.5, 0.5, 0.0]}, ds.InvalidDiscsError, r"disc 2 has radius 0\.0"),
+        ({"masses": [1.0, 0.0, 1.0]}, ds.InvalidDiscsError, r"disc 1 has mass 0\.0"),
+        ({"masses": [1.0, 1.0, np.nan]}, ds.InvalidDiscsError, r"disc 2 has mass nan"),
+        (
+            {"masses": [np.inf, 1.0, 1.0], "velocities": [[1.0, 0], [0, 0], [0, 0]]},
+            ds.InvalidDiscsError,
+            "disc 0 has infinite mass but velocity",
+        ),
+    ],
+)
+def test_bad_discs_are_refused_with_the_disc_and_value(change, error, match):
+    kwargs = {**_ok(), **change}
+    with pytest.raises(error, match=match):
+        ds.Discs(**kwargs)
+
+
+def test_errors_are_value_errors_and_discsim_errors():
+    with pytest.raises(ValueError):
+        ds.Discs([[0.0, 0.0]], [[0.0, 0.0]], -1.0)
+    with pytest.raises(ds.DiscsimError):
+        ds.Discs([[0.0, 0.0]], [[0.0, 0.0]], -1.0)
+
+
+@pytest.mark.parametrize(("w", "h"), [(0.0, 1.0), (-2.0, 1.0), (1.0, np.nan), (np.inf, 1.0)])
+def test_bad_box_is_refused(w, h):
+    with pytest.raises(ds.InvalidDiscsError, match="box (width|height)"):
+        ds.Box(w, h)
+
+
+def test_disc_outside_the_box_or_cut_by_a_wall():
+    discs = ds.Discs([[1.0, 1.0], [9.8, 5.0]], [[0, 0], [0, 0]], 0.5)
+    with pytest.raises(ds.OutsideBoxError, match=r"disc 1 at \[9\.8, 5\.0\] with radius 0\.5 is outside the box or cut"):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0))
+    discs = ds.Discs([[1.0, 1.0], [10.5, 5.0]], [[0, 0], [0, 0]], 0.5)
+    with pytest.raises(ds.OutsideBoxError, match="disc 1 .* outside the periodic box"):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True))
+
+
+def test_overlap_names_the_pair_and_depth():
+    discs = ds.Discs([[2.0, 2.0], [5.0, 5.0], [5.8, 5.0]], np.zeros((3, 2)), 0.5)
+    with pytest.raises(ds.OverlapError, match=r"discs 1 and 2 overlap by 0\.2 "):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0))
+    # across a periodic edge too
+    discs = ds.Discs([[0.2, 5.0], [9.9, 5.0]], np.zeros((2, 2)), 0.5)
+    with pytest.raises(ds.OverlapError, match="discs 0 and 1 overlap by 0.7"):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True))
+
+
+def test_touching_discs_are_allowed():
+    discs = ds.Discs([[2.0, 2.0], [3.0, 2.0]], [[1.0, 0.0], [0.0, 0.0]], 0.5)
+    sim = ds.EventDriven(discs, ds.Box(10.0, 10.0))
+    assert sim.step().time == 0.0  # touching and approaching: they collide at once
+
+
+def test_periodic_box_too_small_for_its_grid():
+    discs = ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], 1.0)
+    with pytest.raises(ds.BoxTooSmallError, match="at least 3 cells"):
+        ds.EventDriven(discs, ds.Box(5.0, 10.0, periodic=True))
+
+
+def test_cell_size_below_the_diameter_is_refused():
+    discs = ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], 1.0)
+    with pytest.raises(ValueError, match="below the largest disc diameter"):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0), cell_size=1.5)
+
+
+def test_unreachable_packing_fraction():
+    with pytest.raises(ds.PackingError, match="cannot be reached"):
+        ds.random_gas(100, 0.95)
+    with pytest.raises(ds.PackingError, match="cannot be reached"):
+        ds.random_gas(100, 0.0)
+    with pytest.raises(ds.PackingError, match="cannot be reached"):
+        ds.random_gas(7, 0.84, periodic=False)
+
+
+def test_errors_leave_the_simulation_untouched():
+    discs, box = ds.random_gas(50, 0.3, seed=0)
+    sim = ds.EventDriven(discs, box).run(until=2.0)
+    before = (sim.time, sim.positions, sim.velocities, dict(sim.counts), sim.events.tobytes())
+    for bad in (1.0, float("nan"), "soon"):
+        with pytest.raises(ds.TimeError):
+            sim.run(until=bad)
+    with pytest.raises(ValueError, match="events must be a non-negative integer"):
+        sim.run(events=-3)
+    after = (sim.time, sim.positions, sim.velocities, dict(sim.counts), sim.events.tobytes())
+    assert before[0] == after[0] and before[3] == after[3] and before[4] == after[4]
+    assert np.array_equal(before[1], after[1]) and np.array_equal(before[2], after[2])
+
+
+def test_input_arrays_are_copied_and_read_only():
+    pos = np.array([[1.0, 1.0], [4.0, 1.0]])
+    discs = ds.Discs(pos, np.zeros((2, 2)), 0.5)
+    pos[0, 0] = 99.0
+    assert discs.positions[0, 0] == 1.0
+    with pytest.raises(ValueError):
+        discs.positions[0, 0] = 5.0

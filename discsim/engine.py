@@ -96,6 +96,14 @@ class Engine(ABC):
             return np.zeros(0, dtype=EVENT_DTYPE)
         return self._event_array()
 
+    def snapshot(self) -> Discs:
+        """The discs as they are now: a new :class:`~discsim.state.Discs` at ``time``.
+
+        Use it to start a fresh engine (or measurement) from an equilibrated state.
+        """
+        d = self.discs
+        return Discs(self.positions, self.velocities, d.radii, d.masses, d.groups)
+
     def kinetic_energy(self) -> float:
         """Total kinetic energy ``sum(m |v|^2) / 2`` (obstacles contribute zero)."""
         return kinetic_energy(self.velocities, self.discs.masses)

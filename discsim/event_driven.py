@@ -64,6 +64,9 @@ class EventDriven(Engine):
         counts (dict[str, int]): ``collisions`` (disc-disc), ``wall_hits``,
             ``cell_crossings``, ``stale`` (invalidated events popped) and
             ``predictions`` (discs re-predicted).
+        max_queue (int): the most events the queue has held at once (at most N).
+        max_overlap (float): the deepest overlap seen at a collision, as a
+            fraction of the contact distance (roundoff only: about 1e-15).
 
     Example:
         >>> import discsim as ds
@@ -117,6 +120,7 @@ class EventDriven(Engine):
         self._last = None
         self._counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0}
         self.max_queue = 0
+        self.max_overlap = 0.0
         self._predict, self._predict_after_crossing, self._predictions = self._make_predictor()
         for i in range(n):
             if self._moving[i]:
@@ -413,6 +417,7 @@ class EventDriven(Engine):
         done = 0
         max_queue = self.max_queue
         now, last, virial = self.time, None, self._virial
+        radius, sqrt, max_overlap = self._radius, math.sqrt, self.max_overlap
         while done != limit:
             popped = pop_before(until)
             if popped is None:
@@ -437,6 +442,10 @@ class EventDriven(Engine):
                 if periodic:
                     dx -= width * round(dx / width)
                     dy -= height * round(dy / height)
+                sigma = radius[i] + radius[j]
+                overlap = 1.0 - sqrt(dx * dx + dy * dy) / sigma
+                if overlap > max_overlap:
+                    max_overlap = overlap
                 vxi, vyi, vxj, vyj = vx[i], vy[i], vx[j], vy[j]
                 uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mass[i], mass[j])
                 vx[i], vy[i], vx[j], vy[j] = uxi, uyi, uxj, uyj
@@ -501,7 +510,7 @@ class EventDriven(Engine):
             if size > max_queue:
                 max_queue = size
         self.max_queue = max_queue
-        self.time, self._virial = now, virial
+        self.time, self._virial, self.max_overlap = now, virial, max_overlap
         if last is not None:
             self._last = last
         counts["collisions"] += n_coll

@@ -85,6 +85,36 @@ class EventDriven(Engine):
         queue: str = "sorted",
         cell_size: float | None = None,
     ):
+        self._setup(discs, box, record, queue, cell_size)
+        n = len(discs)
+        grid = self.grid
+        pos, vel = discs.positions, discs.velocities
+        self._rx, self._ry = pos[:, 0].tolist(), pos[:, 1].tolist()
+        self._vx, self._vy = vel[:, 0].tolist(), vel[:, 1].tolist()
+        self._tr = [0.0] * n
+        self._radius = discs.radii.tolist()
+        self._mass = discs.masses.tolist()
+        self._moving = np.isfinite(discs.masses).tolist()
+        self._count = [0] * n
+        self._cell = grid.cells_of(pos).tolist()
+        self._cells: list[list[int]] = [[] for _ in range(len(grid))]
+        for i, c in enumerate(self._cell):
+            self._cells[c].append(i)
+        self._kept_time, self._kept_partner, self._kept_stamp = [INF] * n, [-1] * n, [0] * n
+        self._queue = _QUEUES[queue](n)
+        self._log = EventLog()
+        self._virial = 0.0
+        self._last = None
+        self._counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0}
+        self.max_overlap = 0.0
+        self._predict, self._predict_after_crossing, self._predictions = self._make_predictor(0)
+        for i in range(n):
+            if self._moving[i]:
+                self._predict(i, 0.0, -1)
+        self.max_queue = len(self._queue)
+
+    def _setup(self, discs, box, record, queue, cell_size) -> None:
+        """Validate and build what depends only on the settings: checks, grid, static lists."""
         super().__init__(discs, box, record)
         if queue not in _QUEUES:
             msg = f"queue must be one of {sorted(_QUEUES)}, got {queue!r}"
@@ -102,30 +132,69 @@ class EventDriven(Engine):
         self.grid = grid
         self.time = 0.0
         self.queue_kind = queue
-        pos, vel = discs.positions, discs.velocities
-        self._rx, self._ry = pos[:, 0].tolist(), pos[:, 1].tolist()
-        self._vx, self._vy = vel[:, 0].tolist(), vel[:, 1].tolist()
-        self._tr = [0.0] * n
+        self.cell_size = cell_size
         self._radius = discs.radii.tolist()
         self._mass = discs.masses.tolist()
         self._moving = np.isfinite(discs.masses).tolist()
-        self._count = [0] * n
-        self._cell = grid.cells_of(pos).tolist()
-        self._cells: list[list[int]] = [[] for _ in range(len(grid))]
-        for i, c in enumerate(self._cell):
-            self._cells[c].append(i)
-        self._queue = _QUEUES[queue](n)
-        self._log = EventLog()
-        self._virial = 0.0
-        self._last = None
-        self._counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0}
-        self.max_queue = 0
-        self.max_overlap = 0.0
-        self._predict, self._predict_after_crossing, self._predictions = self._make_predictor()
-        for i in range(n):
-            if self._moving[i]:
-                self._predict(i, 0.0, -1)
-        self.max_queue = len(self._queue)
+
+    # --- saving and restoring ----------------------------------------------------------
+    _STATE_FLOATS = ("_rx", "_ry", "_vx", "_vy", "_tr", "_kept_time")
+    _STATE_INTS = ("_count", "_cell", "_kept_partner", "_kept_stamp")
+
+    def _get_state(self) -> dict:
+        """Everything needed to continue bit for bit, as numpy arrays and plain numbers."""
+        state = {name: np.array(getattr(self, name), dtype=np.float64) for name in self._STATE_FLOATS}
+        state.update({name: np.array(getattr(self, name), dtype=np.int64) for name in self._STATE_INTS})
+        # Order within a cell decides ties, so it is saved too.
+        state["cell_members"] = np.array([j for members in self._cells for j in members], dtype=np.int64)
+        state["cell_sizes"] = np.array([len(members) for members in self._cells], dtype=np.int64)
+        pending = [(o, *self._queue.pending(o)) for o in range(len(self._rx))]
+        pending = [(o, t, p) for o, t, p in pending if t != INF]
+        state["queue_owner"] = np.array([o for o, _, _ in pending], dtype=np.int64)
+        state["queue_time"] = np.array([t for _, t, _ in pending], dtype=np.float64)
+        state["queue_payload"] = np.array([p for _, _, p in pending], dtype=np.int64).reshape(-1, 3)
+        state["scalars"] = {
+            "time": self.time,
+            "virial": self._virial,
+            "max_overlap": self.max_overlap,
+            "max_queue": self.max_queue,
+            "predictions": self._predictions(),
+            "last": list(self._last) if self._last is not None else None,
+            **self._counts,
+        }
+        state["settings"] = {"record": self.record, "queue": self.queue_kind, "cell_size": self.cell_size}
+        state["events"] = self._log.to_array()
+        return state
+
+    @classmethod
+    def _from_state(cls, discs: Discs, box: Box, state: dict) -> EventDriven:
+        """Rebuild an engine from :meth:`_get_state` output and the initial discs."""
+        settings, scalars = state["settings"], state["scalars"]
+        sim = cls.__new__(cls)
+        sim._setup(discs, box, settings["record"], settings["queue"], settings["cell_size"])
+        for name in cls._STATE_FLOATS + cls._STATE_INTS:
+            setattr(sim, name, state[name].tolist())
+        sizes = state["cell_sizes"].tolist()
+        members = state["cell_members"].tolist()
+        sim._cells, k = [], 0
+        for size in sizes:
+            sim._cells.append(members[k : k + size])
+            k += size
+        sim._queue = _QUEUES[settings["queue"]](len(discs))
+        for owner, t, payload in zip(state["queue_owner"].tolist(), state["queue_time"].tolist(),
+                                     state["queue_payload"].tolist()):
+            sim._queue.push(owner, t, tuple(payload))
+        sim._log = EventLog()
+        if len(state["events"]):
+            sim._log.extend(state["events"])
+        sim.time = scalars["time"]
+        sim._virial = scalars["virial"]
+        sim.max_overlap = scalars["max_overlap"]
+        sim.max_queue = scalars["max_queue"]
+        sim._last = tuple(scalars["last"]) if scalars["last"] is not None else None
+        sim._counts = {k: scalars[k] for k in ("collisions", "wall_hits", "cell_crossings", "stale")}
+        sim._predict, sim._predict_after_crossing, sim._predictions = sim._make_predictor(scalars["predictions"])
+        return sim
 
     # --- public protocol -------------------------------------------------------------
     @property
@@ -234,7 +303,7 @@ class EventDriven(Engine):
         return Event(t, KIND_NAMES[kind], i, j)
 
     # --- prediction ------------------------------------------------------------------
-    def _make_predictor(self):
+    def _make_predictor(self, n_pred: int):
         """Build the prediction closures over the state lists (closures read locals fast).
 
         Returns ``(predict, predict_after_crossing, predictions)``:
@@ -249,7 +318,7 @@ class EventDriven(Engine):
           adjacent and taking the kept collision for the 6 that stay adjacent.
           That equals a full 3x3 re-prediction as long as the kept partner has
           not changed course since; otherwise it falls back to ``predict``.
-        - ``predictions()`` counts the predictions made.
+        - ``predictions()`` counts the predictions made (from ``n_pred``).
 
         The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
         """
@@ -274,11 +343,9 @@ class EventDriven(Engine):
             wall_xhi.append(not periodic and cx == grid.nx - 1)
             wall_ylo.append(not periodic and cy == 0)
             wall_yhi.append(not periodic and cy == grid.ny - 1)
-        n = len(rx)
-        kept_time, kept_partner, kept_stamp = [INF] * n, [-1] * n, [0] * n
+        kept_time, kept_partner, kept_stamp = self._kept_time, self._kept_partner, self._kept_stamp
         push, discard = self._queue.push, self._queue.discard
         sqrt = math.sqrt
-        n_pred = 0
 
         def scan(i, t, exclude, xi, yi, vxi, vyi, ri, c, slots):
             """Earliest collision ``(dt, partner)`` of ``i`` with the discs in ``slots`` of its block."""

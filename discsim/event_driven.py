@@ -26,15 +26,15 @@ import numpy as np
 from discsim.engine import Engine, Event
 from discsim.eventlog import KIND_NAMES, EventLog
 from discsim.grid import CellGrid, check_fits
-from discsim.kernels import resolve_collision
+from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
 from discsim.queue import EventQueue, HeapEventQueue
-from discsim.state import Box, Discs
+from discsim.state import Box, Discs, Segment, normalize_pass_through
 
 __all__ = ["EventDriven"]
 
 INF = math.inf
 # Kinds of queued events. COLLISION and WALL match discsim.eventlog.
-_COLLISION, _WALL, _CROSSING = 0, 1, 2
+_COLLISION, _WALL, _CROSSING, _SEGMENT = 0, 1, 2, 3
 # Directions of a cell crossing.
 _PLUS_X, _MINUS_X, _PLUS_Y, _MINUS_Y = 0, 1, 2, 3
 
@@ -54,6 +54,11 @@ class EventDriven(Engine):
         cell_size: side of the grid cells; default the largest disc diameter,
             grown where needed so that there are at most ``4 N + 9`` cells.
             Never below the largest diameter.
+        segments: fixed :class:`~discsim.state.Segment` walls (walled boxes
+            only), kept in a static per-cell table built once.
+        pass_through: pairs of group labels (``discs.groups``) whose discs do
+            not collide with each other, e.g. ``{(1, 1)}`` for bullets that
+            pass through one another. Free when empty.
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
@@ -84,8 +89,10 @@ class EventDriven(Engine):
         record: bool = True,
         queue: str = "sorted",
         cell_size: float | None = None,
+        segments=(),
+        pass_through=(),
     ):
-        self._setup(discs, box, record, queue, cell_size)
+        self._setup(discs, box, record, queue, cell_size, segments, pass_through)
         n = len(discs)
         grid = self.grid
         pos, vel = discs.positions, discs.velocities
@@ -113,13 +120,22 @@ class EventDriven(Engine):
                 self._predict(i, 0.0, -1)
         self.max_queue = len(self._queue)
 
-    def _setup(self, discs, box, record, queue, cell_size) -> None:
+    def _setup(self, discs, box, record, queue, cell_size, segments, pass_through) -> None:
         """Validate and build what depends only on the settings: checks, grid, static lists."""
         super().__init__(discs, box, record)
         if queue not in _QUEUES:
             msg = f"queue must be one of {sorted(_QUEUES)}, got {queue!r}"
             raise ValueError(msg)
-        check_fits(discs, box)
+        segments = tuple(segments)
+        for k, segment in enumerate(segments):
+            if not isinstance(segment, Segment):
+                msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
+                raise TypeError(msg)
+        if segments and box.periodic:
+            msg = "segments need a box with walls (periodic=False)"
+            raise ValueError(msg)
+        pass_through = normalize_pass_through(pass_through)
+        check_fits(discs, box, segments=segments, pass_through=pass_through)
         n = len(discs)
         diameter = 2.0 * float(discs.radii.max()) if n else 1.0
         if cell_size is None:
@@ -133,6 +149,8 @@ class EventDriven(Engine):
         self.time = 0.0
         self.queue_kind = queue
         self.cell_size = cell_size
+        self.segments = segments
+        self.pass_through = pass_through
         self._radius = discs.radii.tolist()
         self._mass = discs.masses.tolist()
         self._moving = np.isfinite(discs.masses).tolist()
@@ -162,7 +180,13 @@ class EventDriven(Engine):
             "last": list(self._last) if self._last is not None else None,
             **self._counts,
         }
-        state["settings"] = {"record": self.record, "queue": self.queue_kind, "cell_size": self.cell_size}
+        state["settings"] = {
+            "record": self.record,
+            "queue": self.queue_kind,
+            "cell_size": self.cell_size,
+            "segments": [[*s.p0.tolist(), *s.p1.tolist()] for s in self.segments],
+            "pass_through": sorted(self.pass_through),
+        }
         state["events"] = self._log.to_array()
         return state
 
@@ -171,7 +195,16 @@ class EventDriven(Engine):
         """Rebuild an engine from :meth:`_get_state` output and the initial discs."""
         settings, scalars = state["settings"], state["scalars"]
         sim = cls.__new__(cls)
-        sim._setup(discs, box, settings["record"], settings["queue"], settings["cell_size"])
+        segments = [Segment(row[:2], row[2:]) for row in settings.get("segments", [])]
+        sim._setup(
+            discs,
+            box,
+            settings["record"],
+            settings["queue"],
+            settings["cell_size"],
+            segments,
+            [tuple(pair) for pair in settings.get("pass_through", [])],
+        )
         for name in cls._STATE_FLOATS + cls._STATE_INTS:
             setattr(sim, name, state[name].tolist())
         sizes = state["cell_sizes"].tolist()
@@ -345,19 +378,30 @@ class EventDriven(Engine):
             wall_yhi.append(not periodic and cy == grid.ny - 1)
         kept_time, kept_partner, kept_stamp = self._kept_time, self._kept_partner, self._kept_stamp
         push, discard = self._queue.push, self._queue.discard
+        # Collision filter: blocked[g][h] is True when groups g and h pass through each other.
+        filtering = bool(self.pass_through)
+        labels = sorted(set(self.discs.groups.tolist()))
+        index = {g: k for k, g in enumerate(labels)}
+        group = [index[g] for g in self.discs.groups.tolist()]
+        blocked = [[(min(g, h), max(g, h)) in self.pass_through for h in labels] for g in labels]
+        # Segments near each cell (a static structure built once).
+        segment_ends = [(*s.p0.tolist(), *s.p1.tolist()) for s in self.segments]
+        reach = max(self._radius, default=0.0)
+        segments_near = grid.segments_by_cell(self.segments, reach) if segment_ends else [()] * len(grid)
         sqrt = math.sqrt
 
         def scan(i, t, exclude, xi, yi, vxi, vyi, ri, c, slots):
             """Earliest collision ``(dt, partner)`` of ``i`` with the discs in ``slots`` of its block."""
             best, partner = INF, -1
             block, shift = blocks[c], shifts[c]
+            passes = blocked[group[i]] if filtering else None
             for k in slots:
                 members = block[k]
                 if not members:
                     continue
                 sx, sy = shift[k]
                 for j in members:
-                    if j == i or j == exclude:
+                    if j == i or j == exclude or (filtering and passes[group[j]]):
                         continue
                     dvx = vx[j] - vxi
                     dvy = vy[j] - vyi
@@ -381,8 +425,8 @@ class EventDriven(Engine):
                         best, partner = tij, j
             return best, partner
 
-        def schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner):
-            """Push the earlier of the collision at absolute ``t_hit`` and the next wall or crossing."""
+        def schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, exclude):
+            """Push the earlier of the collision at absolute ``t_hit`` and the next wall, segment or crossing."""
             best, kind, other = INF, _CROSSING, 0
             if vxi > 0.0:
                 if wall_xhi[c]:
@@ -412,6 +456,11 @@ class EventDriven(Engine):
                     ty = (ylo[c] - yi) / vyi
                     if ty < best:
                         best, kind, other = ty, _CROSSING, _MINUS_Y
+            for k in segments_near[c]:
+                if k != -2 - exclude:  # not the segment just left
+                    ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, *segment_ends[k])
+                    if ts < best:
+                        best, kind, other = ts, _SEGMENT, k
             if best < 0.0:
                 best = 0.0
             t_best = t + best
@@ -436,7 +485,7 @@ class EventDriven(Engine):
             kept_time[i], kept_partner[i] = t_hit, partner
             if partner >= 0:
                 kept_stamp[i] = count[partner]
-            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner)
+            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, exclude)
 
         def predict_after_crossing(i: int, t: float, direction: int) -> None:
             nonlocal n_pred
@@ -457,7 +506,7 @@ class EventDriven(Engine):
                 t_hit = t + dt_new
                 partner = new_partner
                 kept_time[i], kept_partner[i], kept_stamp[i] = t_hit, partner, count[partner]
-            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner)
+            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, -1)
 
         def predictions() -> int:
             return n_pred
@@ -480,6 +529,7 @@ class EventDriven(Engine):
         width, height, periodic = self.box.width, self.box.height, self.box.periodic
         log = self._log if self.record else None
         counts = self._counts
+        segment_ends = [(*seg.p0.tolist(), *seg.p1.tolist()) for seg in self.segments]
         n_coll = n_wall = n_cross = n_stale = 0
         done = 0
         max_queue = self.max_queue
@@ -542,6 +592,19 @@ class EventDriven(Engine):
                 if log is not None:
                     log.wall(t, i, xi, yi, vx[i], vy[i])
                 predict(i, t, -1)
+                last = (t, _WALL, i, -1)
+            elif kind == _SEGMENT:
+                dt = t - tr[i]
+                xi = rx[i] = rx[i] + vx[i] * dt
+                yi = ry[i] = ry[i] + vy[i] * dt
+                tr[i] = t
+                vx[i], vy[i] = reflect_off_segment(xi, yi, vx[i], vy[i], *segment_ends[other])
+                count[i] += 1
+                n_wall += 1
+                done += 1
+                if log is not None:
+                    log.wall(t, i, xi, yi, vx[i], vy[i])
+                predict(i, t, -2 - other)  # never the same segment again straight away
                 last = (t, _WALL, i, -1)
             else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
                 c = cell[i]

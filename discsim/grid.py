@@ -91,6 +91,24 @@ class CellGrid:
         cy = np.clip((positions[:, 1] / self.ly).astype(np.int64), 0, self.ny - 1)
         return cx * self.ny + cy
 
+    def segments_by_cell(self, segments, reach: float) -> list[tuple[int, ...]]:
+        """For each cell, the indices of the segments that pass within ``reach`` of it.
+
+        A disc of radius <= ``reach`` in a cell can only touch segments listed for
+        that cell. Conservative: a segment within ``reach`` plus half a cell
+        diagonal of the cell's centre is listed.
+        """
+        table: list[list[int]] = [[] for _ in range(len(self))]
+        half_diagonal = 0.5 * math.hypot(self.lx, self.ly)
+        cx, cy = np.meshgrid(np.arange(self.nx), np.arange(self.ny), indexing="ij")
+        centres = np.column_stack([(cx.ravel() + 0.5) * self.lx, (cy.ravel() + 0.5) * self.ly])
+        for k, segment in enumerate(segments):
+            near = np.flatnonzero(segment.distance(centres) <= reach + half_diagonal)
+            for c in near.tolist():
+                table[c].append(k)
+        empty: tuple[int, ...] = ()
+        return [tuple(cell) if cell else empty for cell in table]
+
     def _build_tables(self):
         nx, ny, periodic = self.nx, self.ny, self.box.periodic
         width, height = self.box.width, self.box.height
@@ -198,14 +216,17 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
     return i, j, d
 
 
-def check_fits(discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE) -> None:
-    """Raise if a disc is outside ``box``, cut by a wall, or overlaps another.
+def check_fits(
+    discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE, segments=(), pass_through=frozenset()
+) -> None:
+    """Raise if a disc is outside ``box``, cut by a wall or a segment, or overlaps another.
 
     Overlaps deeper than ``tolerance`` times the contact distance are errors;
-    touching discs are allowed. O(N) with a cell grid.
+    touching discs are allowed, and so are overlaps between groups that pass
+    through each other (``pass_through``: sorted group pairs). O(N) with a cell grid.
 
     Raises:
-        OutsideBoxError: naming the disc, its position and radius.
+        OutsideBoxError: naming the disc, its position and radius (and the segment).
         OverlapError: naming the deepest overlapping pair and the depth.
     """
     pos, rad = discs.positions, discs.radii
@@ -223,7 +244,18 @@ def check_fits(discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE) -> 
         i = int(np.flatnonzero(bad)[0])
         msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is {what} (box {box.width:g} x {box.height:g})"
         raise OutsideBoxError(msg)
+    for k, segment in enumerate(segments):
+        cut = segment.distance(pos) < rad * (1.0 - tolerance)
+        if cut.any():
+            i = int(np.flatnonzero(cut)[0])
+            msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is cut by segment {k} {segment!r}"
+            raise OutsideBoxError(msg)
     i, j, d = neighbour_pairs(pos, 2.0 * float(rad.max()), box)
+    if pass_through:
+        gi, gj = discs.groups[i], discs.groups[j]
+        lo, hi = np.minimum(gi, gj), np.maximum(gi, gj)
+        keep = np.array([(a, b) not in pass_through for a, b in zip(lo.tolist(), hi.tolist())], dtype=bool)
+        i, j, d = i[keep], j[keep], d[keep]
     contact = rad[i] + rad[j]
     dist = np.hypot(d[:, 0], d[:, 1])
     depth = contact - dist

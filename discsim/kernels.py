@@ -9,7 +9,14 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["resolve_collision", "time_of_impact", "wall_time"]
+__all__ = [
+    "closest_point_on_segment",
+    "reflect_off_segment",
+    "resolve_collision",
+    "segment_time_of_impact",
+    "time_of_impact",
+    "wall_time",
+]
 
 INF = math.inf
 
@@ -96,3 +103,74 @@ def wall_time(x: float, v: float, radius: float, length: float) -> float:
     if v < 0.0:
         return max((radius - x) / v, 0.0)
     return INF
+
+
+def segment_time_of_impact(
+    px: float, py: float, vx: float, vy: float, radius: float, ax: float, ay: float, bx: float, by: float
+) -> float:
+    """Time until a moving disc touches the fixed segment from ``a`` to ``b``.
+
+    The disc (centre ``p``, velocity ``v``, ``radius``) can touch the segment's
+    face, where the contact point is the foot of the perpendicular, or one of
+    its end points, which act as discs of radius 0. A disc already touching or
+    overlapping while approaching touches at once (``t = 0``).
+
+    Returns:
+        The time (>= 0) of the first contact, or ``math.inf`` if none.
+
+    Example:
+        >>> segment_time_of_impact(0.0, 5.0, 0.0, -1.0, 1.0, -3.0, 0.0, 3.0, 0.0)
+        4.0
+        >>> round(segment_time_of_impact(5.0, 0.6, -1.0, 0.0, 1.0, 0.0, -3.0, 0.0, 0.0), 12)  # the end (0, 0)
+        4.2
+    """
+    ex, ey = bx - ax, by - ay
+    length2 = ex * ex + ey * ey
+    best = INF
+    length = math.sqrt(length2)
+    nx, ny = -ey / length, ex / length
+    s = (px - ax) * nx + (py - ay) * ny  # signed distance of the centre from the line
+    vn = vx * nx + vy * ny
+    if s < 0.0:
+        s, vn = -s, -vn
+    if vn < 0.0:  # moving towards the line
+        t = (s - radius) / -vn if s > radius else 0.0
+        u = ((px + vx * t - ax) * ex + (py + vy * t - ay) * ey) / length2
+        if 0.0 <= u <= 1.0:
+            best = t
+    for qx, qy in ((ax, ay), (bx, by)):
+        t = time_of_impact(qx - px, qy - py, -vx, -vy, radius)
+        if t < best:
+            best = t
+    return best
+
+
+def closest_point_on_segment(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> tuple[float, float]:
+    """The point of segment ``a``-``b`` nearest to ``p``.
+
+    Example:
+        >>> closest_point_on_segment(1.0, 2.0, 0.0, 0.0, 4.0, 0.0)
+        (1.0, 0.0)
+    """
+    ex, ey = bx - ax, by - ay
+    u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
+    u = min(max(u, 0.0), 1.0)
+    return ax + u * ex, ay + u * ey
+
+
+def reflect_off_segment(
+    px: float, py: float, vx: float, vy: float, ax: float, ay: float, bx: float, by: float
+) -> tuple[float, float]:
+    """Velocity after an elastic bounce of a disc at ``p`` off segment ``a``-``b``.
+
+    The normal runs from the nearest point of the segment to the centre: the
+    face's normal on the face, the radial direction at an end point.
+
+    Example:
+        >>> reflect_off_segment(0.0, 1.0, 1.0, -2.0, -3.0, 0.0, 3.0, 0.0)
+        (1.0, 2.0)
+    """
+    qx, qy = closest_point_on_segment(px, py, ax, ay, bx, by)
+    nx, ny = px - qx, py - qy
+    k = 2.0 * (vx * nx + vy * ny) / (nx * nx + ny * ny)
+    return vx - k * nx, vy - k * ny

@@ -14,7 +14,7 @@ import numpy as np
 
 from discsim.errors import InvalidDiscsError
 
-__all__ = ["Box", "Discs", "kinetic_energy", "momentum"]
+__all__ = ["Box", "Discs", "Segment", "kinetic_energy", "momentum", "normalize_pass_through", "polygon"]
 
 #: Relative tolerance on the contact distance below which two discs count as overlapping.
 OVERLAP_TOLERANCE = 1e-9
@@ -209,3 +209,83 @@ class Box:
         if self.periodic:
             d = d - self.size * np.round(d / self.size)
         return d
+
+
+class Segment:
+    """A fixed line-segment wall from ``p0`` to ``p1`` (both sides reflect).
+
+    Segments build polygonal tables (a triangle, a stadium's straight sides)
+    inside a walled box. Discs bounce off the face and off the end points.
+
+    Args:
+        p0, p1: end points ``(2,)`` in length units; finite and distinct.
+
+    Example:
+        >>> Segment((0, 0), (3, 4)).length
+        5.0
+    """
+
+    __slots__ = ("p0", "p1")
+
+    def __init__(self, p0, p1):
+        a = np.array(p0, dtype=np.float64)
+        b = np.array(p1, dtype=np.float64)
+        for name, p in (("p0", a), ("p1", b)):
+            if p.shape != (2,) or not np.isfinite(p).all():
+                msg = f"segment {name} must be 2 finite numbers, got {p.tolist()}"
+                raise InvalidDiscsError(msg)
+        if np.array_equal(a, b):
+            msg = f"segment end points must differ, got {a.tolist()} twice"
+            raise InvalidDiscsError(msg)
+        self.p0 = _readonly(a)
+        self.p1 = _readonly(b)
+
+    @property
+    def length(self) -> float:
+        """Length of the segment."""
+        return float(np.hypot(*(self.p1 - self.p0)))
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Distance ``(N,)`` from each of ``points`` ``(N, 2)`` to the segment."""
+        points = np.atleast_2d(points)
+        e = self.p1 - self.p0
+        u = np.clip((points - self.p0) @ e / (e @ e), 0.0, 1.0)
+        nearest = self.p0 + u[:, None] * e
+        return np.hypot(*(points - nearest).T)
+
+    def __repr__(self) -> str:
+        return f"Segment({self.p0.tolist()}, {self.p1.tolist()})"
+
+
+def polygon(vertices) -> list[Segment]:
+    """The closed chain of segments through ``vertices`` ``(K, 2)``.
+
+    Example:
+        >>> len(polygon([(1, 1), (9, 1), (5, 8)]))
+        3
+    """
+    v = np.asarray(vertices, dtype=float)
+    return [Segment(v[k], v[(k + 1) % len(v)]) for k in range(len(v))]
+
+
+def normalize_pass_through(pairs) -> frozenset:
+    """Validate a collision filter: pairs of group labels whose discs pass through each other.
+
+    Returns a frozenset of sorted ``(g1, g2)`` tuples.
+
+    Example:
+        >>> sorted(normalize_pass_through([(2, 1), (3, 3)]))
+        [(1, 2), (3, 3)]
+    """
+    out = set()
+    for pair in pairs or ():
+        try:
+            g1, g2 = pair
+        except (TypeError, ValueError) as exc:
+            msg = f"pass_through must hold pairs of group labels, got {pair!r}"
+            raise InvalidDiscsError(msg) from exc
+        if int(g1) != g1 or int(g2) != g2:
+            msg = f"group labels must be integers, got {pair!r}"
+            raise InvalidDiscsError(msg)
+        out.add((min(int(g1), int(g2)), max(int(g1), int(g2))))
+    return frozenset(out)

@@ -11,14 +11,15 @@ import math
 
 import numpy as np
 
-from discsim.kernels import time_of_impact, wall_time
+from discsim.kernels import segment_time_of_impact, time_of_impact, wall_time
 
 
-def next_event(positions, velocities, radii, masses, box, exclude=()):
+def next_event(positions, velocities, radii, masses, box, exclude=(), segments=(), groups=None, pass_through=()):
     """``(dt, kind, i, j)`` of the earliest event from this state; kind 'collision' or 'wall'.
 
     ``exclude`` holds unordered pairs (frozensets) that have just collided and are
-    separating, which the engine likewise skips.
+    separating, which the engine likewise skips. Segment hits count as 'wall'.
+    Pairs whose sorted groups are in ``pass_through`` never collide.
     """
     n = len(radii)
     best = (math.inf, None, -1, -1)
@@ -29,6 +30,8 @@ def next_event(positions, velocities, radii, masses, box, exclude=()):
     for i in range(n):
         for j in range(i + 1, n):
             if not (moving[i] or moving[j]) or frozenset((i, j)) in exclude:
+                continue
+            if groups is not None and (min(groups[i], groups[j]), max(groups[i], groups[j])) in pass_through:
                 continue
             d = positions[j] - positions[i]
             if box.periodic:
@@ -44,4 +47,11 @@ def next_event(positions, velocities, radii, masses, box, exclude=()):
                 t = wall_time(positions[i, axis], velocities[i, axis], radii[i], length)
                 if t < best[0]:
                     best = (t, "wall", i, -1)
+    for i in range(n):
+        for k, seg in enumerate(segments):
+            if frozenset((i, -2 - k)) in exclude:
+                continue
+            t = segment_time_of_impact(*positions[i], *velocities[i], radii[i], *seg.p0, *seg.p1)
+            if t < best[0]:
+                best = (t, "wall", i, -1)
     return best

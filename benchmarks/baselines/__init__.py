@@ -1,0 +1,1 @@
+"""Reference implementations that discsim is measured against (never imported by discsim)."""

@@ -1,0 +1,168 @@
+"""The benchmark scripts run (in their ``--quick`` mode) and the naive baseline agrees with discsim.
+
+No test here asserts a speed: timings belong to the scripts' output, not to pass/fail.
+"""
+
+import csv
+import doctest
+import importlib.util
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import discsim as ds
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+def _load(name: str, path: Path):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+naive = _load("naive_event_driven", BENCHMARKS / "baselines" / "naive_event_driven.py")
+benchutils = _load("benchutils", BENCHMARKS / "benchutils.py")
+
+
+# --- the scripts run -------------------------------------------------------------------
+def _run_quick(script: str, results: Path) -> subprocess.CompletedProcess:
+    env = dict(os.environ, MPLBACKEND="Agg")
+    return subprocess.run(
+        [sys.executable, str(BENCHMARKS / script), "--quick", "--results", str(results)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
+        check=False,
+    )
+
+
+def _read_csv(path: Path) -> list[dict]:
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+@pytest.mark.slow
+def test_throughput_quick_writes_its_csv_and_plot(tmp_path):
+    done = _run_quick("throughput.py", tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = _read_csv(tmp_path / "throughput.csv")
+    assert len(rows) == 4  # 2 sizes x 2 packing fractions
+    for row in rows:
+        assert float(row["collisions_per_s"]) > 0
+        assert 0 < int(row["max_queue"]) <= int(row["n"])  # one pending event per disc at most
+        assert float(row["peak_mb"]) > 0
+    queues = _read_csv(tmp_path / "throughput_queue.csv")
+    assert sorted(r["queue"] for r in queues) == ["heap", "sorted"]
+    assert (tmp_path / "throughput.png").stat().st_size > 0
+    assert "coll/s" in done.stdout
+
+
+@pytest.mark.slow
+def test_peers_quick_writes_its_csv_and_plot(tmp_path):
+    done = _run_quick("peers.py", tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = _read_csv(tmp_path / "peers.csv")
+    engines = {r["engine"] for r in rows}
+    assert {"discsim", "naive", "billiards"} <= engines  # billiards appears even when skipped
+    ran = [r for r in rows if r["engine"] in ("discsim", "naive") and r["status"] == "ok"]
+    assert len(ran) == 4  # 2 sizes x 2 engines
+    assert (tmp_path / "peers.png").stat().st_size > 0
+
+
+# --- the naive baseline agrees with discsim event by event ------------------------------
+def _events(sim, count: int) -> list:
+    return [sim.step() for _ in range(count)]
+
+
+def _groups(events, rel: float = 1e-9) -> list[list]:
+    """Split a time-ordered event list into runs of events at the same time (within ``rel``)."""
+    groups = []
+    for event in events:
+        if groups and math.isclose(event.time, groups[-1][0].time, rel_tol=rel, abs_tol=1e-12):
+            groups[-1].append(event)
+        else:
+            groups.append([event])
+    return groups
+
+
+def _assert_same_events(expected, got):
+    """Same times (1e-9 relative) and the same discs, event by event; simultaneous events in any order."""
+    assert None not in expected and None not in got
+    assert len(expected) == len(got)
+    for a, b in zip(expected, got, strict=True):
+        assert b.time == pytest.approx(a.time, rel=1e-9, abs=1e-12), (a, b)
+    for group_a, group_b in zip(_groups(expected), _groups(got), strict=True):
+        assert sorted(map(_who, group_a)) == sorted(map(_who, group_b)), (group_a, group_b)
+
+
+def _who(event) -> tuple:
+    return event.kind, min(event.i, event.j), max(event.i, event.j)
+
+
+@pytest.mark.parametrize(
+    ("n", "periodic"),
+    [(20, False), (30, True)],
+)
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_naive_baseline_follows_event_driven(n, periodic, seed):
+    discs, box = ds.random_gas(n, 0.3, periodic=periodic, seed=seed)
+    expected = _events(ds.EventDriven(discs, box), 50)
+    baseline = naive.NaiveEventDriven(discs, box)
+    got = _events(baseline, 50)
+    _assert_same_events(expected, got)
+    assert baseline.counts["collisions"] + baseline.counts["wall_hits"] == 50
+
+
+def test_naive_baseline_with_mixed_discs_and_an_obstacle():
+    rng = np.random.default_rng(3)
+    positions = [[3.0, 3.0], [9.0, 3.5], [5.0, 8.0], [12.0, 10.0], [8.0, 12.5], [15.0, 5.0]]
+    radii = [1.0, 0.5, 1.5, 0.7, 1.0, 1.2]
+    masses = [1.0, 0.3, 4.0, 1.0, np.inf, 2.0]
+    velocities = rng.normal(size=(6, 2))
+    velocities[4] = 0.0  # the obstacle rests
+    discs = ds.Discs(positions, velocities, radii, masses)
+    box = ds.Box(18.0, 15.0)
+    # Roundoff grows about tenfold every few collisions here: by event 47 it passes 1e-9.
+    expected = _events(ds.EventDriven(discs, box), 40)
+    _assert_same_events(expected, _events(naive.NaiveEventDriven(discs, box), 40))
+
+
+def test_naive_baseline_runs_to_a_time_and_conserves_energy():
+    discs, box = ds.random_gas(25, 0.4, periodic=True, seed=5)
+    reference = ds.EventDriven(discs, box).run(until=3.0)
+    baseline = naive.NaiveEventDriven(discs, box).run(until=3.0)
+    assert baseline.time == 3.0
+    assert baseline.counts["collisions"] == reference.counts["collisions"]
+    assert baseline.counts["refreshes"] >= 1  # the periodic box re-predicts everything now and then
+    energy = 0.5 * float(np.sum(baseline.velocities**2))
+    assert energy == pytest.approx(discs.kinetic_energy(), rel=1e-12)
+    shift = box.displacement(reference.positions, baseline.positions)
+    assert np.abs(shift).max() < 1e-8
+
+
+def test_naive_baseline_docstring_example():
+    assert doctest.testmod(naive, raise_on_error=False).failed == 0
+
+
+# --- helpers ---------------------------------------------------------------------------
+def test_time_limit_interrupts_a_long_block():
+    if not hasattr(__import__("signal"), "setitimer"):
+        pytest.skip("no SIGALRM on this platform")
+    start = time.perf_counter()
+    with pytest.raises(benchutils.TimeLimitExceeded), benchutils.time_limit(0.05):
+        while True:
+            pass
+    assert time.perf_counter() - start < 5.0
+
+
+def test_format_table_docstring_example():
+    assert doctest.testmod(benchutils, raise_on_error=False).failed == 0

@@ -361,7 +361,6 @@ class EventDriven(Engine):
         nobody: list[int] = []  # stands for the cells a wall cuts off
         blocks = [tuple(self._cells[c2] if c2 >= 0 else nobody for c2 in grid.neighbours[c]) for c in range(len(grid))]
         shifts = grid.shifts
-        whole_block = range(9)
         front = {_PLUS_X: (6, 7, 8), _MINUS_X: (0, 1, 2), _PLUS_Y: (2, 5, 8), _MINUS_Y: (0, 3, 6)}
         width, height, periodic = box.width, box.height, box.periodic
         # Per-cell boundaries, and whether a wall stands beyond each side.
@@ -390,24 +389,22 @@ class EventDriven(Engine):
         segments_near = grid.segments_by_cell(self.segments, reach) if segment_ends else [()] * len(grid)
         sqrt = math.sqrt
 
-        def scan(i, t, exclude, xi, yi, vxi, vyi, ri, c, slots):
-            """Earliest collision ``(dt, partner)`` of ``i`` with the discs in ``slots`` of its block."""
+        def scan(i, t, exclude, xi, yi, vxi, vyi, ri, cells_and_shifts):
+            """Earliest collision ``(dt, partner)`` of ``i`` with the discs of ``(cell, (sx, sy))`` pairs."""
             best, partner = INF, -1
-            block, shift = blocks[c], shifts[c]
             passes = blocked[group[i]] if filtering else None
-            for k in slots:
-                members = block[k]
+            for members, (sx, sy) in cells_and_shifts:
                 if not members:
                     continue
-                sx, sy = shift[k]
+                ox, oy = sx - xi, sy - yi
                 for j in members:
                     if j == i or j == exclude or (filtering and passes[group[j]]):
                         continue
                     dvx = vx[j] - vxi
                     dvy = vy[j] - vyi
                     dtj = t - tr[j]
-                    dx = rx[j] + vx[j] * dtj + sx - xi
-                    dy = ry[j] + vy[j] * dtj + sy - yi
+                    dx = rx[j] + vx[j] * dtj + ox
+                    dy = ry[j] + vy[j] * dtj + oy
                     b = dx * dvx + dy * dvy
                     if b >= 0.0:
                         continue
@@ -480,7 +477,7 @@ class EventDriven(Engine):
             yi = ry[i] + vyi * dti
             ri = radius[i]
             c = cell[i]
-            dt_hit, partner = scan(i, t, exclude, xi, yi, vxi, vyi, ri, c, whole_block)
+            dt_hit, partner = scan(i, t, exclude, xi, yi, vxi, vyi, ri, zip(blocks[c], shifts[c]))
             t_hit = t + dt_hit
             kept_time[i], kept_partner[i] = t_hit, partner
             if partner >= 0:
@@ -500,7 +497,11 @@ class EventDriven(Engine):
             yi = ry[i] + vyi * dti
             ri = radius[i]
             c = cell[i]
-            dt_new, new_partner = scan(i, t, -1, xi, yi, vxi, vyi, ri, c, front[direction])
+            block, shift = blocks[c], shifts[c]
+            k0, k1, k2 = front[direction]
+            dt_new, new_partner = scan(
+                i, t, -1, xi, yi, vxi, vyi, ri, ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2]))
+            )
             t_hit = kept_time[i]
             if t + dt_new < t_hit:
                 t_hit = t + dt_new

@@ -214,8 +214,9 @@ class EventDriven(Engine):
             sim._cells.append(members[k : k + size])
             k += size
         sim._queue = _QUEUES[settings["queue"]](len(discs))
-        for owner, t, payload in zip(state["queue_owner"].tolist(), state["queue_time"].tolist(),
-                                     state["queue_payload"].tolist()):
+        for owner, t, payload in zip(
+            state["queue_owner"].tolist(), state["queue_time"].tolist(), state["queue_payload"].tolist()
+        ):
             sim._queue.push(owner, t, tuple(payload))
         sim._log = EventLog()
         if len(state["events"]):

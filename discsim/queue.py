@@ -134,9 +134,7 @@ class HeapEventQueue:
                 self._compact()
 
     def _compact(self) -> None:
-        self._heap = [
-            (t, o, self._version[o]) for o, t in enumerate(self._time) if t != math.inf
-        ]
+        self._heap = [(t, o, self._version[o]) for o, t in enumerate(self._time) if t != math.inf]
         heapq.heapify(self._heap)
 
     def _drop_dead(self) -> None:

@@ -9,8 +9,6 @@ from oracle import next_event
 import discsim as ds
 
 
-
-
 def _lockstep_times(sim, steps):
     d = sim.discs
     just_collided = set()

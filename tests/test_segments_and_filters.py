@@ -142,9 +142,15 @@ def test_filtered_gas_follows_the_oracle_and_allows_overlaps_within_passing_grou
     normalized = {tuple(sorted(p)) for p in rules}
     for _ in range(300):
         t0 = sim.time
-        dt, kind, i, j = next_event(
-            sim.positions, sim.velocities, discs.radii, discs.masses, box, exclude,
-            groups=groups, pass_through=normalized,
+        dt, _, i, j = next_event(
+            sim.positions,
+            sim.velocities,
+            discs.radii,
+            discs.masses,
+            box,
+            exclude,
+            groups=groups,
+            pass_through=normalized,
         )
         event = sim.step()
         assert event.time == pytest.approx(t0 + dt, rel=1e-9, abs=1e-9)

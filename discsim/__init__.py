@@ -6,8 +6,15 @@ The public API::
     discs, box = ds.random_gas(1000, 0.3, seed=0)
     sim = ds.EventDriven(discs, box).run(until=10.0)      # PIC: exact collision times
     sim.counts, sim.kinetic_energy(), sim.pressure()
+
+    case = ds.scenarios.wrong_direction()                 # the study's PIT failures
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate).run(until=case.until)
+    pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    print(ds.compare(pic, pit))                           # PIT against the truth
 """
 
+from discsim import scenarios
+from discsim.compare import Comparison, compare
 from discsim.engine import Event
 from discsim.errors import (
     BoxTooSmallError,
@@ -20,8 +27,9 @@ from discsim.errors import (
     TimeError,
 )
 from discsim.event_driven import EventDriven
+from discsim.fixed_step import FixedStep
 from discsim.observables import compressibility_factor, enskog_collision_rate, henderson_z
-from discsim.scenarios import random_gas
+from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
 from discsim.state import Box, Discs
 
 __version__ = "0.1.0"
@@ -30,17 +38,26 @@ __all__ = [
     "Box",
     "BoxTooSmallError",
     "CheckpointError",
+    "Comparison",
     "Discs",
     "DiscsimError",
     "Event",
     "EventDriven",
+    "FixedStep",
     "InvalidDiscsError",
     "OutsideBoxError",
     "OverlapError",
     "PackingError",
+    "Scenario",
     "TimeError",
+    "billiard_break",
+    "compare",
     "compressibility_factor",
     "enskog_collision_rate",
+    "head_on",
     "henderson_z",
+    "newtons_cradle",
     "random_gas",
+    "scenarios",
+    "study_cases",
 ]

@@ -7,13 +7,25 @@ fraction. The study's four PIT failure cases and other set pieces live here too.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from discsim.errors import PackingError
 from discsim.state import Box, Discs
 
-__all__ = ["random_gas"]
+__all__ = [
+    "Scenario",
+    "billiard_break",
+    "delay",
+    "head_on",
+    "missed_collision",
+    "multiple_collisions",
+    "newtons_cradle",
+    "random_gas",
+    "study_cases",
+    "wrong_direction",
+]
 
 #: Densest packing fraction a triangular lattice reaches in a square box here.
 _MAX_PACKING = 0.85
@@ -119,3 +131,282 @@ def random_gas(
     if energy > 0:
         velocities *= math.sqrt(n * temperature / energy)
     return Discs(positions, velocities, radius, mass), Box(side, side, periodic=periodic)
+
+
+# --- set pieces: the study's four PIT failures and classic demonstrations -------------------------------
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A ready-made initial condition with the frame rate and horizon to run it at.
+
+    Attributes:
+        discs: the discs at time 0.
+        box: the box.
+        frame_rate: frames per unit time for a fixed-step (PIT) run; the
+            study's failures show at this rate.
+        until: the horizon (time units); a whole number of frames.
+        name: a short identifier, e.g. ``"missed_collision"``.
+        description: one or two sentences on what happens and what PIT gets wrong.
+
+    Example:
+        >>> case = missed_collision()
+        >>> case.name, len(case.discs), case.frame_rate, case.until
+        ('missed_collision', 2, 10.0, 0.4)
+    """
+
+    discs: Discs
+    box: Box
+    frame_rate: float
+    until: float
+    name: str
+    description: str
+
+    @property
+    def dt(self) -> float:
+        """The frame interval ``1 / frame_rate`` (time units)."""
+        return 1.0 / self.frame_rate
+
+
+def missed_collision() -> Scenario:
+    """Study case 1: a small fast disc passes through another between two frames.
+
+    Two discs of radius 0.2 (contact distance 0.4) in a 20 x 10 box; disc 0
+    flies at speed 30 along y = 5 towards disc 1, which drifts up slowly. At 10
+    frames per unit time disc 0 moves 3 per frame: it is 1.5 short of disc 1 at
+    one frame and 1.5 past it at the next, so PIT never sees them overlap. The
+    exact contact is at t = 0.137 (disc 0 nearly stops, disc 1 takes its speed).
+
+    Example:
+        >>> case = missed_collision()
+        >>> case.discs.velocities.tolist()
+        [[30.0, 0.0], [0.0, 0.5]]
+    """
+    discs = Discs([[1.0, 5.0], [5.5, 4.95]], [[30.0, 0.0], [0.0, 0.5]], radii=0.2)
+    return Scenario(
+        discs,
+        Box(20.0, 10.0),
+        frame_rate=10.0,
+        until=0.4,
+        name="missed_collision",
+        description="A small fast disc crosses another between two frames: PIT misses the collision.",
+    )
+
+
+def wrong_direction() -> Scenario:
+    """Study case 2: an oblique collision found late, when the line of centres has turned.
+
+    Disc 0 (radius 1, speed 6 along x) hits the resting disc 1 with an impact
+    parameter of 1.2. At contact the line of centres makes
+    ``atan(1.2 / 1.6) = 36.87`` degrees with x; at 5 frames per unit time PIT
+    first sees the discs 0.6 apart in x, where the line makes
+    ``atan(1.2 / 0.6) = 63.43`` degrees, so both discs leave about 26.6 degrees
+    off their true directions.
+
+    Example:
+        >>> case = wrong_direction()
+        >>> case.discs.positions.tolist()
+        [[1.8, 3.0], [6.0, 4.2]]
+    """
+    discs = Discs([[1.8, 3.0], [6.0, 4.2]], [[6.0, 0.0], [0.0, 0.0]], radii=1.0)
+    return Scenario(
+        discs,
+        Box(12.0, 10.0),
+        frame_rate=5.0,
+        until=1.0,
+        name="wrong_direction",
+        description=(
+            "An oblique collision is detected late, with the discs deep in each other: "
+            "the line of centres has turned, and both discs leave in wrong directions."
+        ),
+    )
+
+
+def multiple_collisions() -> Scenario:
+    """Study case 3: a chain A -> B -> static C whose second link PIT misses.
+
+    The first collision is that of :func:`wrong_direction`: disc 0 hits disc 1,
+    which should leave at 36.87 degrees with speed 4.8 and hit the static disc
+    2 (infinite mass) 6 units along that line at t = 1.27. Under PIT the first
+    contact is found late, disc 1 leaves at 63.43 degrees and passes disc 2 at
+    a distance of 2.68 > 2 (the contact distance): the second collision never
+    happens.
+
+    Example:
+        >>> case = multiple_collisions()
+        >>> case.discs.masses.tolist()
+        [1.0, 1.0, inf]
+    """
+    discs = Discs(
+        [[1.8, 3.0], [6.0, 4.2], [10.8, 7.8]],
+        [[6.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+        radii=1.0,
+        masses=[1.0, 1.0, np.inf],
+    )
+    return Scenario(
+        discs,
+        Box(14.0, 10.0),
+        frame_rate=5.0,
+        until=1.6,
+        name="multiple_collisions",
+        description=(
+            "A disc should knock a second one into a static third; PIT finds the first contact "
+            "late, sends the second disc off course, and misses the second collision."
+        ),
+    )
+
+
+def delay() -> Scenario:
+    """Study case 4: PIT responds only once the discs overlap, so all that follows is late.
+
+    Two discs of radius 1 approach at speed 3 each along nearly the same line
+    (offset 0.3). They touch at t = 4/3 - 0.0023 = 1.3311; at 5 frames per unit
+    time PIT responds at t = 1.4, 0.069 late. The discs leave in almost the
+    right directions (a few degrees off), but along paths shifted by about
+    ``2 v delay = 0.4`` from the true ones.
+
+    Example:
+        >>> case = delay()
+        >>> case.frame_rate, case.until
+        (5.0, 2.4)
+    """
+    discs = Discs([[2.0, 5.0], [12.0, 5.3]], [[3.0, 0.0], [-3.0, 0.0]], radii=1.0)
+    return Scenario(
+        discs,
+        Box(14.0, 10.0),
+        frame_rate=5.0,
+        until=2.4,
+        name="delay",
+        description=(
+            "PIT responds only after the discs overlap: they leave in almost the right "
+            "directions but late, so their paths are shifted."
+        ),
+    )
+
+
+def study_cases() -> list[Scenario]:
+    """The study's four PIT failure cases, in the study's order.
+
+    Example:
+        >>> [case.name for case in study_cases()]
+        ['missed_collision', 'wrong_direction', 'multiple_collisions', 'delay']
+    """
+    return [missed_collision(), wrong_direction(), multiple_collisions(), delay()]
+
+
+def head_on(m1: float = 1.0, m2: float = 1.0) -> Scenario:
+    """A head-on collision of disc 0 (mass ``m1``, speed 1) with disc 1 (mass ``m2``, at rest).
+
+    Radius 1, centres 4 apart on y = 5 in a 20 x 10 box; contact at t = 2.
+    After it the velocities along x are exactly
+    ``(m1 - m2) / (m1 + m2)`` and ``2 m1 / (m1 + m2)`` (or -1 and 0 when
+    ``m2`` is ``numpy.inf``). A head-on line of centres does not turn, so PIT
+    gets these velocities right too, only late.
+
+    Args:
+        m1: mass of the moving disc (positive, finite).
+        m2: mass of the resting disc (positive; ``numpy.inf`` for a fixed one).
+
+    Raises:
+        InvalidDiscsError: if a mass is not positive, or ``m1`` is infinite.
+
+    Example:
+        >>> case = head_on(1.0, 3.0)
+        >>> case.discs.masses.tolist(), case.until
+        ([1.0, 3.0], 4.0)
+    """
+    discs = Discs([[4.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [0.0, 0.0]], radii=1.0, masses=[m1, m2])
+    return Scenario(
+        discs,
+        Box(20.0, 10.0),
+        frame_rate=10.0,
+        until=4.0,
+        name="head_on",
+        description=f"Head-on collision of masses {m1:g} (moving) and {m2:g} (at rest).",
+    )
+
+
+def newtons_cradle(n: int = 5) -> Scenario:
+    """Newton's cradle: a striker hits a row of ``n - 1`` touching discs at rest.
+
+    Equal discs of radius 1 on y = 2; the striker starts at x = 2 with speed 1,
+    the row starts at x = 6 with centres exactly 2 apart, so the contact is at
+    t = 2. Exactly, the momentum passes down the row at once: the last disc
+    leaves at speed 1 and the others stop. PIT passes it on one frame at a time.
+
+    Args:
+        n: number of discs, striker included (>= 2).
+
+    Raises:
+        ValueError: if ``n`` is not an integer >= 2.
+
+    Example:
+        >>> case = newtons_cradle(4)
+        >>> case.discs.positions[:, 0].tolist()
+        [2.0, 6.0, 8.0, 10.0]
+    """
+    if isinstance(n, bool) or int(n) != n or n < 2:
+        msg = f"n must be an integer >= 2, got {n!r}"
+        raise ValueError(msg)
+    n = int(n)
+    x = np.concatenate([[2.0], 6.0 + 2.0 * np.arange(n - 1)])
+    positions = np.column_stack([x, np.full(n, 2.0)])
+    velocities = np.zeros((n, 2))
+    velocities[0, 0] = 1.0
+    discs = Discs(positions, velocities, radii=1.0)
+    return Scenario(
+        discs,
+        Box(2.0 * n + 14.0, 4.0),
+        frame_rate=10.0,
+        until=8.0,
+        name="newtons_cradle",
+        description=f"Newton's cradle of {n} discs: a striker hits a row of touching discs.",
+    )
+
+
+def billiard_break(rows: int = 5, speed: float = 20.0) -> Scenario:
+    """A triangle rack of ``rows * (rows + 1) / 2`` discs broken by a cue disc.
+
+    Discs of radius 1 and mass 1 in a 60 x 30 box with walls. The rack's apex
+    points at the cue disc (disc 0), which starts 20 to its left, 0.01 off the
+    axis, at ``speed`` along x. Neighbours in the rack are 2 (1 + 1e-6) apart,
+    so nothing overlaps at the start.
+
+    Args:
+        rows: rows of the rack (>= 1).
+        speed: speed of the cue disc (positive).
+
+    Raises:
+        ValueError: if ``rows`` is not a positive integer or ``speed`` is not positive.
+
+    Example:
+        >>> case = billiard_break()
+        >>> len(case.discs), case.discs.velocities[0].tolist()
+        (16, [20.0, 0.0])
+    """
+    if isinstance(rows, bool) or int(rows) != rows or rows < 1 or rows > 12:
+        msg = f"rows must be an integer in [1, 12], got {rows!r}"
+        raise ValueError(msg)
+    if not (speed > 0 and math.isfinite(speed)):
+        msg = f"speed must be positive and finite, got {speed!r}"
+        raise ValueError(msg)
+    rows = int(rows)
+    spacing = 2.0 * (1.0 + 1e-6)
+    apex = np.array([30.0, 15.0])
+    rack = [
+        apex + np.array([row * spacing * math.sqrt(3.0) / 2.0, (k - row / 2.0) * spacing])
+        for row in range(rows)
+        for k in range(row + 1)
+    ]
+    positions = np.vstack([[apex[0] - 20.0, apex[1] + 0.01], *rack])
+    velocities = np.zeros_like(positions)
+    velocities[0, 0] = speed
+    discs = Discs(positions, velocities, radii=1.0)
+    return Scenario(
+        discs,
+        Box(60.0, 30.0),
+        frame_rate=60.0,
+        until=3.0,
+        name="billiard_break",
+        description=f"A cue disc at speed {speed:g} breaks a triangle rack of {len(rack)} discs.",
+    )

@@ -1,0 +1,450 @@
+"""Pictures of discs, paths, PIT-against-PIC cases and animations (matplotlib).
+
+The only module of discsim that imports matplotlib. Every function reads the
+engine protocol (``discs``, ``box``, ``time``, ``positions``, ``velocities``,
+``events``, ``trajectory``), so it draws any engine; it uses ``dt`` (the frame
+interval) when an engine has one. Each returns the matplotlib object it made or
+drew on; with ``ax=None`` it makes a new figure.
+
+Lengths are drawn to scale: discs are circles of their true radii and the
+axes have equal aspect.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib import animation
+from matplotlib.collections import PatchCollection
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Rectangle
+
+from discsim.eventlog import COLLISION
+from discsim.state import Discs
+
+__all__ = ["animate", "close", "plot_case", "plot_state", "plot_trajectories", "save_figure"]
+
+_OBSTACLE = "0.55"
+
+
+def _colours(n: int) -> list:
+    cycle = plt.get_cmap("tab10").colors
+    return [cycle[k % len(cycle)] for k in range(n)]
+
+
+def _disc_colours(masses: np.ndarray) -> list:
+    colours = _colours(len(masses))
+    return [_OBSTACLE if math.isinf(m) else c for m, c in zip(masses.tolist(), colours, strict=True)]
+
+
+def _axes(ax, figsize=(6.0, 4.5)):
+    if ax is None:
+        _, ax = plt.subplots(figsize=figsize)
+    return ax
+
+
+def _setup(ax, box) -> None:
+    ax.set_aspect("equal")
+    if box is None:
+        ax.autoscale_view()
+        return
+    style = {"linestyle": ":"} if box.periodic else {}
+    ax.add_patch(Rectangle((0.0, 0.0), box.width, box.height, fill=False, edgecolor="0.2", linewidth=1.2, **style))
+    pad = 0.02 * max(box.width, box.height)
+    ax.set_xlim(-pad, box.width + pad)
+    ax.set_ylim(-pad, box.height + pad)
+
+
+def _circles(ax, positions, radii, colours, *, alpha=0.6, fill=True, linestyle="-", linewidth=1.0, zorder=2):
+    patches = [Circle((float(x), float(y)), float(r)) for (x, y), r in zip(positions, radii, strict=True)]
+    if fill:
+        collection = PatchCollection(
+            patches, facecolors=colours, edgecolors=colours, alpha=alpha, linewidths=linewidth, zorder=zorder
+        )
+    else:
+        collection = PatchCollection(
+            patches, facecolors="none", edgecolors=colours, linestyles=linestyle, linewidths=linewidth, zorder=zorder
+        )
+    ax.add_collection(collection)
+    return collection
+
+
+def _arrows(ax, positions, velocities, scale_time, colours, zorder=4):
+    """Velocity arrows drawn to scale: an arrow is where the disc gets in ``scale_time``."""
+    if not len(positions) or scale_time <= 0:
+        return None
+    return ax.quiver(
+        positions[:, 0],
+        positions[:, 1],
+        velocities[:, 0] * scale_time,
+        velocities[:, 1] * scale_time,
+        color=colours,
+        angles="xy",
+        scale_units="xy",
+        scale=1.0,
+        width=0.004,
+        zorder=zorder,
+    )
+
+
+def _arrow_time(radii: np.ndarray, velocities: np.ndarray) -> float:
+    speed = float(np.hypot(velocities[:, 0], velocities[:, 1]).max()) if len(velocities) else 0.0
+    return 4.0 * float(radii.max()) / speed if speed > 0 else 0.0
+
+
+def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
+    """Draw discs as circles to scale, with velocity arrows.
+
+    Args:
+        sim_or_discs: an engine (drawn at its current ``time``) or a
+            :class:`~discsim.state.Discs`.
+        ax: matplotlib axes to draw on; None makes a new figure.
+        box: the box to outline; default the engine's box (none for bare discs).
+        arrows: draw velocity arrows; the longest is four radii of the largest
+            disc long, the others to the same scale.
+
+    Returns:
+        The matplotlib ``Axes``.
+
+    Example:
+        >>> import discsim as ds
+        >>> ax = plot_state(ds.Discs([[2.0, 2.0]], [[1.0, 0.0]], radii=1.0), box=ds.Box(5.0, 4.0))
+        >>> len(ax.collections) >= 1
+        True
+        >>> close(ax)
+    """
+    if isinstance(sim_or_discs, Discs):
+        discs, positions, velocities, time = sim_or_discs, sim_or_discs.positions, sim_or_discs.velocities, None
+    else:
+        sim = sim_or_discs
+        discs, positions, velocities, time = sim.discs, sim.positions, sim.velocities, sim.time
+        box = sim.box if box is None else box
+    ax = _axes(ax)
+    colours = _disc_colours(discs.masses)
+    _circles(ax, positions, discs.radii, colours)
+    if arrows:
+        _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
+    _setup(ax, box)
+    if box is None and len(positions):
+        r = float(discs.radii.max())
+        ax.set_xlim(positions[:, 0].min() - 2 * r, positions[:, 0].max() + 2 * r)
+        ax.set_ylim(positions[:, 1].min() - 2 * r, positions[:, 1].max() + 2 * r)
+    if time is not None:
+        ax.set_title(f"{type(sim_or_discs).__name__} at t = {time:.4g}")
+    return ax
+
+
+def _sample_times(sim, samples: int) -> np.ndarray:
+    """Evenly spaced times over the simulated span plus every event time (for sharp corners)."""
+    start, end = float(sim.start_time), float(sim.time)
+    times = np.linspace(start, end, max(2, samples))
+    events = sim.events
+    if len(events):
+        et = events["time"]
+        times = np.union1d(times, et[(et >= start) & (et <= end)])
+    return times
+
+
+def _break_wraps(path: np.ndarray, box) -> np.ndarray:
+    """Insert NaN rows where a periodic path jumps across the box, so lines are not drawn across it."""
+    if box is None or not box.periodic or len(path) < 2:
+        return path
+    jump = (np.abs(np.diff(path, axis=0)) > 0.5 * box.size).any(axis=1)
+    if not jump.any():
+        return path
+    return np.insert(path, np.flatnonzero(jump) + 1, np.nan, axis=0)
+
+
+def plot_trajectories(sim, ax=None, discs=None, *, samples: int = 400):
+    """Draw the paths of discs over the simulated span, from the event log.
+
+    Args:
+        sim: an engine built with ``record=True``.
+        ax: matplotlib axes; None makes a new figure.
+        discs: indices of the discs to draw; default all when N <= 50,
+            else the first 50.
+        samples: evenly spaced sample times, on top of every event time.
+
+    Returns:
+        The matplotlib ``Axes`` (paths as lines, start as dots, final discs as outlines).
+
+    Example:
+        >>> import discsim as ds
+        >>> case = ds.head_on(1.0, 2.0)
+        >>> sim = ds.EventDriven(case.discs, case.box).run(until=case.until)
+        >>> ax = plot_trajectories(sim)
+        >>> len(ax.lines)
+        2
+        >>> close(ax)
+    """
+    n = len(sim.discs)
+    chosen = np.arange(min(n, 50)) if discs is None else np.atleast_1d(np.asarray(discs, dtype=np.int64))
+    if chosen.size and (chosen.min() < 0 or chosen.max() >= n):
+        bad = int(chosen[(chosen < 0) | (chosen >= n)][0])
+        msg = f"disc index {bad} is out of range for {n} discs"
+        raise IndexError(msg)
+    ax = _axes(ax)
+    times = _sample_times(sim, samples)
+    paths = sim.trajectory(times)
+    colours = _disc_colours(sim.discs.masses)
+    for i in chosen.tolist():
+        path = _break_wraps(paths[:, i, :], sim.box)
+        ax.plot(path[:, 0], path[:, 1], color=colours[i], linewidth=1.2)
+    starts = paths[0, chosen]
+    ax.scatter(starts[:, 0], starts[:, 1], s=8, c=[colours[i] for i in chosen.tolist()], zorder=3)
+    _circles(ax, paths[-1, chosen], sim.discs.radii[chosen], [colours[i] for i in chosen.tolist()], fill=False)
+    _setup(ax, sim.box)
+    ax.set_title(f"{type(sim).__name__}: paths over t in [{times[0]:.3g}, {times[-1]:.3g}]")
+    return ax
+
+
+def _frame_times(truth, approx, max_frames: int) -> np.ndarray:
+    start = max(float(truth.start_time), float(approx.start_time))
+    end = min(float(truth.time), float(approx.time))
+    dt = max(float(getattr(e, "dt", 0.0) or 0.0) for e in (truth, approx))
+    if dt > 0:
+        count = math.floor((end - start) / dt * (1 + 1e-12) + 1e-9)
+        times = np.minimum(start + dt * np.arange(count + 1), end)
+    else:
+        times = np.linspace(start, end, 11)
+    if len(times) > max_frames:
+        times = times[np.linspace(0, len(times) - 1, max_frames).round().astype(int)]
+    return times
+
+
+def _case_limits(frames_list, radii, box):
+    """Axis limits ``(x0, x1, y0, y1)`` around every drawn disc, within the box (plus a margin)."""
+    points = np.concatenate([f.reshape(-1, 2) for f in frames_list])
+    margin = 1.5 * float(radii.max())
+    pad = 0.02 * max(box.width, box.height)
+    x0 = max(-pad, float(points[:, 0].min()) - margin)
+    x1 = min(box.width + pad, float(points[:, 0].max()) + margin)
+    y0 = max(-pad, float(points[:, 1].min()) - margin)
+    y1 = min(box.height + pad, float(points[:, 1].max()) + margin)
+    return x0, x1, y0, y1
+
+
+def _draw_case_panel(ax, sim, truth, frames, times, arrow_time, contact_style, title, limits):
+    discs = sim.discs
+    colours = _disc_colours(discs.masses)
+    n = len(discs)
+    label = len(times) <= 25 and n <= 12
+    for k, positions in enumerate(frames):
+        alpha = 0.12 + 0.43 * k / max(1, len(frames) - 1)
+        _circles(ax, positions, discs.radii, colours, alpha=alpha, linewidth=0.6)
+        if label:
+            for i in range(n):
+                if k > 0 and not np.isinf(discs.masses[i]) and np.allclose(positions[i], frames[k - 1][i]):
+                    continue  # a disc at rest: label its first frame only
+                ax.text(*positions[i], str(k), ha="center", va="center", fontsize=6, color="0.15", zorder=5)
+    # Exact contacts (the truth's collisions) as unfilled outlines.
+    ev = truth.events
+    ev = ev[(ev["kind"] == COLLISION) & (ev["time"] <= times[-1])]
+    for rec in ev[:40]:
+        for d, x, y in ((int(rec["i"]), rec["xi"], rec["yi"]), (int(rec["j"]), rec["xj"], rec["yj"])):
+            ax.add_patch(
+                Circle(
+                    (float(x), float(y)),
+                    float(discs.radii[d]),
+                    fill=False,
+                    edgecolor=colours[d],
+                    linestyle=contact_style,
+                    linewidth=1.6,
+                    zorder=3,
+                )
+            )
+    # Velocities after each of this engine's collisions.
+    own = sim.events
+    own = own[(own["kind"] == COLLISION) & (own["time"] <= times[-1])][:40]
+    if len(own):
+        pos = np.concatenate([np.column_stack([own["xi"], own["yi"]]), np.column_stack([own["xj"], own["yj"]])])
+        vel = np.concatenate([np.column_stack([own["vxi"], own["vyi"]]), np.column_stack([own["vxj"], own["vyj"]])])
+        who = np.concatenate([own["i"], own["j"]]).tolist()
+        _arrows(ax, pos, vel, arrow_time, [colours[d] for d in who])
+    _setup(ax, sim.box)
+    ax.set_xlim(limits[0], limits[1])
+    ax.set_ylim(limits[2], limits[3])
+    ax.set_title(title, fontsize=10)
+
+
+def plot_case(truth, approx, *, title: str | None = None, max_frames: int = 40):
+    """PIT and PIC side by side, drawn like the study's figures.
+
+    Each panel shows the discs at every frame time (fainter earlier, frame
+    numbers on small cases), zoomed to where the discs go, the exact contacts of the truth as unfilled
+    outlines (solid on the PIC panel, dashed on the PIT panel, for reference)
+    and each disc's velocity after each of that run's collisions as an arrow
+    (drawn as the path covered in two frames).
+
+    Args:
+        truth: the exact run (PIC), drawn on the right.
+        approx: the fixed-step run (PIT), drawn on the left; its ``dt`` sets
+            the frame times.
+        title: figure title.
+        max_frames: at most this many frame times are drawn (evenly thinned).
+
+    Returns:
+        The matplotlib ``Figure``.
+
+    Example:
+        >>> import discsim as ds
+        >>> case = ds.scenarios.delay()
+        >>> pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
+        >>> pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate).run(until=case.until)
+        >>> fig = plot_case(pic, pit, title=case.name)
+        >>> len(fig.axes)
+        2
+        >>> close(fig)
+    """
+    times = _frame_times(truth, approx, max_frames)
+    dt = float(getattr(approx, "dt", 0.0) or 0.0) or (times[-1] - times[0]) / 10.0
+    frames_pit, frames_pic = approx.trajectory(times), truth.trajectory(times)
+    limits = _case_limits([frames_pit, frames_pic], truth.discs.radii, truth.box)
+    aspect = (limits[3] - limits[2]) / (limits[1] - limits[0])
+    fig, (ax_pit, ax_pic) = plt.subplots(1, 2, figsize=(11.0, min(9.0, max(3.0, 5.5 * aspect + 1.2))))
+    rate = f", {1.0 / dt:.3g} frames per unit time" if dt > 0 else ""
+    _draw_case_panel(
+        ax_pit, approx, truth, frames_pit, times, 2.0 * dt, "--", f"PIT ({type(approx).__name__}{rate})", limits
+    )
+    _draw_case_panel(
+        ax_pic, truth, truth, frames_pic, times, 2.0 * dt, "-", f"PIC ({type(truth).__name__}), the truth", limits
+    )
+    handles = [
+        Line2D([], [], color="0.3", linestyle="-", linewidth=1.6, label="exact contact (PIC)"),
+        Line2D([], [], color="0.3", linestyle="--", linewidth=1.6, label="exact contact, for reference"),
+        Line2D([], [], color="0.3", marker=r"$\rightarrow$", linestyle="none", markersize=12, label="velocity after"),
+    ]
+    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8, frameon=False)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
+    return fig
+
+
+def _animation_times(sims, max_frames: int) -> np.ndarray:
+    start = max(float(s.start_time) for s in sims)
+    end = min(float(s.time) for s in sims)
+    dt = max(float(getattr(s, "dt", 0.0) or 0.0) for s in sims)
+    if dt > 0:
+        count = math.floor((end - start) / dt * (1 + 1e-12) + 1e-9)
+        times = np.minimum(start + dt * np.arange(count + 1), end)
+    else:
+        times = np.linspace(start, end, 61)
+    if len(times) > max_frames:
+        times = times[np.linspace(0, len(times) - 1, max_frames).round().astype(int)]
+    return times
+
+
+def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max_frames: int = 200, title=None):
+    """Animate one run, or several side by side, from their event logs.
+
+    Args:
+        sim: an engine, or a sequence of engines over the same box (e.g.
+            ``[pit, pic]``), each built with ``record=True``.
+        path: where to save: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
+            None saves nothing.
+        times: the frame times ``(T,)``; default the frame times of the run
+            with the largest ``dt`` (or 61 evenly spaced times), at most
+            ``max_frames`` of them.
+        fps: frames per second of the movie.
+        dpi: resolution of a saved movie.
+        max_frames: cap on the default number of frames.
+        title: figure title.
+
+    Returns:
+        The ``matplotlib.animation.FuncAnimation``.
+
+    Raises:
+        ValueError: on a file suffix other than ``.gif`` or ``.mp4``.
+        RuntimeError: for ``.mp4`` when no ffmpeg writer is available.
+
+    Example:
+        >>> import discsim as ds
+        >>> case = ds.head_on(1.0, 1.0)
+        >>> sim = ds.EventDriven(case.discs, case.box).run(until=case.until)
+        >>> anim = animate(sim)
+        >>> close(anim)
+    """
+    sims = list(sim) if isinstance(sim, Sequence) else [sim]
+    if not sims:
+        msg = "animate() needs at least one engine"
+        raise ValueError(msg)
+    if path is not None:
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".gif", ".mp4"):
+            msg = f"animate() saves .gif or .mp4 files, got {str(path)!r}"
+            raise ValueError(msg)
+        if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
+            msg = f"cannot write {str(path)!r}: MP4 needs ffmpeg, which was not found; save a .gif instead"
+            raise RuntimeError(msg)
+    times = _animation_times(sims, max_frames) if times is None else np.atleast_1d(np.asarray(times, dtype=float))
+    box = sims[0].box
+    aspect = box.height / box.width
+    width = 4.5 * len(sims)
+    fig, axes = plt.subplots(1, len(sims), figsize=(width, max(2.5, 4.5 * aspect + 0.8)), squeeze=False)
+    panels = []
+    for ax, s in zip(axes[0], sims, strict=True):
+        paths = s.trajectory(times)
+        colours = _disc_colours(s.discs.masses)
+        circles = [
+            Circle(tuple(paths[0, i]), float(r), facecolor=c, edgecolor=c, alpha=0.75)
+            for i, (r, c) in enumerate(zip(s.discs.radii, colours, strict=True))
+        ]
+        for c in circles:
+            ax.add_patch(c)
+        _setup(ax, s.box)
+        ax.set_title(type(s).__name__, fontsize=10)
+        panels.append((paths, circles))
+    clock = fig.text(0.01, 0.01, "", fontsize=9)
+    if title:
+        fig.suptitle(title)
+
+    def update(k):
+        changed = [clock]
+        for paths, circles in panels:
+            for i, c in enumerate(circles):
+                c.set_center(tuple(paths[k, i]))
+            changed.extend(circles)
+        clock.set_text(f"t = {times[k]:.3f}")
+        return changed
+
+    update(0)
+    anim = animation.FuncAnimation(fig, update, frames=len(times), interval=1000.0 / fps, blit=False)
+    if path is not None:
+        writer = animation.PillowWriter(fps=fps) if path.suffix.lower() == ".gif" else animation.FFMpegWriter(fps=fps)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        anim.save(str(path), writer=writer, dpi=dpi)
+    return anim
+
+
+def _figure_of(obj):
+    if isinstance(obj, animation.Animation):
+        return obj._fig
+    return getattr(obj, "figure", obj)
+
+
+def save_figure(obj, path, *, dpi: int = 110) -> Path:
+    """Save the figure of ``obj`` (a Figure or Axes) to ``path``, close it, and return the path.
+
+    Example:
+        >>> import tempfile, discsim as ds
+        >>> ax = plot_state(ds.Discs([[1.0, 1.0]], [[0.0, 0.0]], radii=0.5), box=ds.Box(2.0, 2.0))
+        >>> save_figure(ax, tempfile.mkdtemp() + "/state.png").exists()
+        True
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = _figure_of(obj)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
+def close(obj) -> None:
+    """Close the figure of ``obj`` (a Figure, Axes or animation), freeing its memory."""
+    plt.close(_figure_of(obj))

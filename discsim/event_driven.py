@@ -19,13 +19,18 @@ re-predict, push.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import uuid
+from pathlib import Path
 
 import numpy as np
 
 from discsim.engine import Engine, Event
-from discsim.eventlog import KIND_NAMES, EventLog
+from discsim.errors import CheckpointError
+from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, EventLog, stream_header
 from discsim.grid import CellGrid, check_fits
+from discsim.io import RecordWriter, read_state, write_state
 from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
 from discsim.queue import EventQueue, HeapEventQueue
 from discsim.state import Box, Discs, Segment, normalize_pass_through
@@ -114,7 +119,7 @@ class EventDriven(Engine):
         self._last = None
         self._counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0}
         self.max_overlap = 0.0
-        self._predict, self._predict_after_crossing, self._predictions = self._make_predictor(0)
+        self._predict, self._predictions = self._make_predictor(0)
         for i in range(n):
             if self._moving[i]:
                 self._predict(i, 0.0, -1)
@@ -227,7 +232,7 @@ class EventDriven(Engine):
         sim.max_queue = scalars["max_queue"]
         sim._last = tuple(scalars["last"]) if scalars["last"] is not None else None
         sim._counts = {k: scalars[k] for k in ("collisions", "wall_hits", "cell_crossings", "stale")}
-        sim._predict, sim._predict_after_crossing, sim._predictions = sim._make_predictor(scalars["predictions"])
+        sim._predict, sim._predictions = sim._make_predictor(scalars["predictions"])
         return sim
 
     # --- public protocol -------------------------------------------------------------
@@ -272,7 +277,16 @@ class EventDriven(Engine):
             raise ValueError(msg)
         return (self.kinetic_energy() + self._virial / (2.0 * elapsed)) / self.box.area
 
-    def run(self, until: float | None = None, *, events: int | None = None, progress: bool = False):
+    def run(
+        self,
+        until: float | None = None,
+        *,
+        events: int | None = None,
+        progress: bool = False,
+        record_to=None,
+        checkpoint=None,
+        checkpoint_every: int | None = None,
+    ):
         """Process events up to time ``until`` and/or for ``events`` physical events.
 
         Args:
@@ -280,14 +294,38 @@ class EventDriven(Engine):
                 ``time`` is set to ``until`` at the end.
             events: stop after this many collisions plus wall hits (cell
                 crossings and stale events are bookkeeping and not counted).
-            progress: show a tqdm progress bar.
+            progress: show a tqdm progress bar (simulated time or events, and
+                collisions per second).
+            record_to: stream the event log to this file in chunks of
+                :attr:`stream_chunk` events (about 90 bytes per event), so
+                memory stays flat. Works with ``record=False`` too. A new file
+                starts with the discs where the log starts; the engine's own
+                log file (after a resume, or a second ``run`` call) is
+                continued; any other existing file is refused. Read it with
+                :func:`discsim.read_events`; ``events`` and ``trajectory()``
+                are then unavailable on the engine.
+            checkpoint: write the whole state to this file (see :meth:`save`)
+                when the run starts, every ``checkpoint_every`` physical
+                events, and when it ends. A file already there must be a
+                checkpoint of this same run (it is then replaced); anything
+                else is refused. After a crash, :func:`discsim.resume`
+                continues from the last checkpoint to the same final state,
+                bit for bit.
+            checkpoint_every: physical events between checkpoints (needs
+                ``checkpoint``); default only at the start and the end.
 
         Returns:
             ``self``, so calls chain.
 
         Raises:
             TimeError: if ``until`` is before ``time`` or NaN.
-            ValueError: if neither limit is given, or ``events`` is negative.
+            ValueError: if neither limit is given, ``events`` is negative, or
+                ``checkpoint_every`` is not a positive integer or comes without
+                ``checkpoint``.
+            CheckpointError: if ``record_to`` or ``checkpoint`` names a file
+                that is damaged or belongs to another run (left untouched), or
+                the engine's log on disk has a gap (events run while not
+                recording). Nothing has been simulated then.
         """
         if until is None and events is None:
             msg = "run() needs until=... or events=..."
@@ -297,32 +335,25 @@ class EventDriven(Engine):
             msg = f"events must be a non-negative integer, got {events!r}"
             raise ValueError(msg)
         limit_n = -1 if events is None else int(events)
-        if progress:
-            done = self._run_with_progress(limit_t, limit_n)
-        else:
+        if checkpoint_every is not None:
+            if checkpoint is None:
+                msg = "checkpoint_every needs checkpoint=path"
+                raise ValueError(msg)
+            if isinstance(checkpoint_every, bool) or int(checkpoint_every) != checkpoint_every or checkpoint_every < 1:
+                msg = f"checkpoint_every must be a positive integer (physical events), got {checkpoint_every!r}"
+                raise ValueError(msg)
+            checkpoint_every = int(checkpoint_every)
+        if record_to is None and checkpoint is None and not progress:
             done = self._process(limit_t, limit_n)
-        if limit_t != INF and done != limit_n:  # stopped by the clock, not by the event count
-            self.time = limit_t
+            if limit_t != INF and done != limit_n:  # stopped by the clock, not by the event count
+                self.time = limit_t
+            return self
+        self._run_in_chunks(limit_t, limit_n, progress, record_to, checkpoint, checkpoint_every)
         return self
 
     def _run_with_progress(self, limit_t: float, limit_n: int) -> int:
-        from discsim.progress import progress_bar
-
-        by_time = limit_n < 0
-        total = (limit_t - self.time) if by_time else limit_n
-        with progress_bar(total, by_time=by_time) as bar:
-            done = 0
-            while True:
-                chunk = 20_000 if limit_n < 0 else min(20_000, limit_n - done)
-                t0 = self.time
-                k = self._process(limit_t, chunk)
-                done += k
-                bar.update(self.time - t0 if by_time else k, self.counts["collisions"])
-                if k < chunk or (limit_n >= 0 and done >= limit_n) or chunk == 0:
-                    break
-            if by_time and limit_t != INF and (limit_n < 0 or done < limit_n):
-                bar.update(limit_t - self.time, self.counts["collisions"])
-        return done
+        """Run with a progress bar only; return the physical events processed."""
+        return self._run_in_chunks(limit_t, limit_n, True, None, None, None)
 
     def step(self) -> Event | None:
         """Process events up to and including the next collision or wall hit.
@@ -336,22 +367,276 @@ class EventDriven(Engine):
         t, kind, i, j = self._last
         return Event(t, KIND_NAMES[kind], i, j)
 
+    # --- long runs: progress, streamed logs, checkpoints --------------------------------
+    #: Events per chunk of a log streamed by ``run(record_to=...)``; at most this
+    #: many events are held in memory while streaming.
+    stream_chunk = 16_384
+    #: Physical events per call of the hot loop between progress-bar updates.
+    _PROGRESS_CHUNK = 20_000
+    # Class-level defaults, so that engines built by __init__ or _from_state have them.
+    _run_id: str | None = None  # identifies this run in its checkpoints and streamed log
+    _stream: dict | None = None  # this run's log on disk: path, run_id, base, records, end
+
+    def _physical(self) -> int:
+        """Physical events (collisions plus wall hits) processed since the start."""
+        return self._counts["collisions"] + self._counts["wall_hits"]
+
+    def _ensure_run_id(self) -> str:
+        if self._run_id is None:
+            self._run_id = uuid.uuid4().hex
+        return self._run_id
+
+    def _run_in_chunks(self, limit_t, limit_n, progress, record_to, checkpoint, every) -> int:
+        """Run in slices of the hot loop, between which the bar, the log on disk and checkpoints are served.
+
+        The slices change nothing in the dynamics: ``_process`` resumes exactly
+        where it stopped. Returns the physical events processed.
+        """
+        from discsim.progress import progress_bar
+
+        checkpoint = None if checkpoint is None else Path(checkpoint)
+        if checkpoint is not None:
+            self._check_checkpoint_target(checkpoint)
+        writer = None if record_to is None else self._open_stream(Path(record_to))
+        target = {
+            "until": None if limit_t == INF else limit_t,
+            "events": None if limit_n < 0 else self._physical() + limit_n,
+            "checkpoint_every": every,
+            "record_to": None if writer is None else str(writer.path),
+        }
+        recording = self.record
+        by_time = limit_n < 0
+        try:
+            self.record = recording or writer is not None  # the hot loop logs only when record is on
+            if checkpoint is not None:
+                self._write_checkpoint(checkpoint, writer, recording, {**target, "finished": False})
+            total = limit_t - self.time if by_time else limit_n
+            with progress_bar(total, by_time) if progress else contextlib.nullcontext() as bar:
+                done = since_checkpoint = 0
+                while True:
+                    chunk = self._PROGRESS_CHUNK
+                    if limit_n >= 0:
+                        chunk = min(chunk, limit_n - done)
+                    if every is not None:
+                        chunk = min(chunk, every - since_checkpoint)
+                    if writer is not None:
+                        chunk = min(chunk, max(1, self.stream_chunk - len(self._log)))
+                    t0 = self.time
+                    k = self._process(limit_t, chunk)
+                    done += k
+                    since_checkpoint += k
+                    if bar is not None:
+                        bar.update(self.time - t0 if by_time else k, self._counts["collisions"])
+                    if writer is not None and len(self._log) >= self.stream_chunk:
+                        self._flush_stream(writer)
+                    if every is not None and since_checkpoint >= every:
+                        self._write_checkpoint(checkpoint, writer, recording, {**target, "finished": False})
+                        since_checkpoint = 0
+                    if k < chunk or done == limit_n:
+                        break
+                if limit_t != INF and done != limit_n:  # stopped by the clock, not by the event count
+                    if bar is not None and by_time:
+                        bar.update(limit_t - self.time, self._counts["collisions"])
+                    self.time = limit_t
+            if writer is not None:
+                self._flush_stream(writer)
+            if checkpoint is not None:
+                self._write_checkpoint(checkpoint, writer, recording, {**target, "finished": True})
+        finally:
+            self.record = recording
+            if writer is not None:
+                writer.close()
+        return done
+
+    def _open_stream(self, path: Path) -> RecordWriter:
+        """The writer of this run's log at ``path``: a new file, or this run's own file continued.
+
+        Checks everything before touching anything: a foreign or damaged file,
+        or a gap in the log (events processed while nothing recorded them),
+        raises CheckpointError and leaves the file and the engine as they were.
+        """
+        stream, physical = self._stream, self._physical()
+        if path.exists():
+            if stream is None:
+                msg = (
+                    f"{path} already exists and is not this run's event log; discsim will not overwrite it "
+                    "(choose another path or remove the file)"
+                )
+                raise CheckpointError(msg)
+            if stream["base"] + stream["records"] + len(self._log) != physical:
+                missed = physical - stream["base"] - stream["records"] - len(self._log)
+                msg = (
+                    f"{path}: the log on disk stops {missed} events before the engine (they ran without "
+                    "record_to and record=False); stream to a new file instead"
+                )
+                raise CheckpointError(msg)
+            writer = RecordWriter.reopen(
+                path, stream["records"], stream["end"], expect={"run_id": stream["run_id"], "base": stream["base"]}
+            )
+            self._stream = {**stream, "path": str(path)}
+            return writer
+        if stream is None and len(self._log) == physical:
+            discs, start, base = self.discs, self.start_time, 0  # the log covers the run from its start
+        else:
+            discs, start, base = self.snapshot(), self.time, physical
+            self._log.drain()  # events before ``start`` do not belong to the new file
+        meta, arrays = stream_header(discs, self.box, start, self._ensure_run_id(), base)
+        writer = RecordWriter.create(path, EVENT_DTYPE, meta, arrays)
+        self._stream = {"path": str(path), "run_id": self._run_id, "base": base, "records": 0, "end": writer.end}
+        return writer
+
+    def _flush_stream(self, writer: RecordWriter) -> None:
+        """Move the in-memory log to disk as one chunk, stamped with the time it covers up to."""
+        writer.append(self._log.drain(), {"time": self.time})
+        self._stream = {**self._stream, "records": writer.records, "end": writer.end}
+
+    def _check_checkpoint_target(self, path: Path) -> None:
+        """Refuse to overwrite a file that is not a checkpoint of this run (damaged ones included)."""
+        if not path.parent.is_dir():
+            msg = f"cannot write the checkpoint {path}: no folder {path.parent}"
+            raise FileNotFoundError(msg)
+        if path.exists():
+            meta, _ = read_state(path)
+            if self._run_id is None or meta.get("run_id") != self._run_id:
+                msg = (
+                    f"{path} holds a checkpoint of another run; discsim will not overwrite it "
+                    "(choose another path, or resume that run with discsim.resume)"
+                )
+                raise CheckpointError(msg)
+
+    def _write_checkpoint(self, path: Path, writer, recording: bool, run: dict) -> None:
+        """Sync the log on disk first, then write the state, so a checkpoint never refers past the log."""
+        if writer is not None:
+            self._flush_stream(writer)
+            writer.sync()
+        state = self._get_state()
+        state["settings"] = {**state["settings"], "record": recording}  # not the forced recording of streaming
+        self._write_state_file(path, state, run)
+
+    def save(self, path) -> Path:
+        """Write the whole state to one file, so that :func:`discsim.load` continues bit for bit.
+
+        The file holds the initial discs, the box, the time, the counters, the
+        settings, the event queue, the per-disc clocks and the event log if
+        recorded (or where it was streamed). It is written to a temporary
+        file in the same folder and renamed over ``path``, so a crash never
+        leaves half a file; a SHA-256 checksum and a format version guard the
+        reading. Plain numbers and JSON only, no pickle: loading a file never
+        runs code from it. An existing ``path`` is replaced.
+
+        Args:
+            path: the file to write (its folder must exist).
+
+        Returns:
+            The path written, as a :class:`~pathlib.Path`.
+
+        Example:
+            >>> import os, tempfile, discsim as ds
+            >>> discs, box = ds.random_gas(50, 0.4, seed=2)
+            >>> path = os.path.join(tempfile.mkdtemp(), "sim.dsc")
+            >>> a = ds.EventDriven(discs, box).run(until=1.0)
+            >>> _ = a.save(path)
+            >>> b = ds.load(path)
+            >>> a.run(until=3.0).events.tobytes() == b.run(until=3.0).events.tobytes()
+            True
+        """
+        return self._write_state_file(Path(path), self._get_state(), None)
+
+    def _write_state_file(self, path: Path, state: dict, run: dict | None) -> Path:
+        """Lay out ``_get_state()`` output plus the initial discs for :func:`discsim.io.write_state`."""
+        discs, box = self.discs, self.box
+        meta = {
+            "engine": type(self).__name__,
+            "run_id": self._ensure_run_id(),
+            "start_time": self.start_time,
+            "box": {"width": box.width, "height": box.height, "periodic": box.periodic},
+            "state": {k: v for k, v in state.items() if not isinstance(v, np.ndarray)},
+            "stream": self._stream,
+            "run": run,
+        }
+        arrays = {f"state.{k}": v for k, v in state.items() if isinstance(v, np.ndarray)}
+        arrays.update(
+            {
+                "discs.positions": discs.positions,
+                "discs.velocities": discs.velocities,
+                "discs.radii": discs.radii,
+                "discs.masses": discs.masses,
+                "discs.groups": discs.groups,
+            }
+        )
+        return write_state(path, meta, arrays)
+
+    @classmethod
+    def _from_saved(cls, meta: dict, arrays: dict) -> EventDriven:
+        """Rebuild an engine from what :meth:`_write_state_file` wrote (see :func:`discsim.load`)."""
+        discs = Discs(
+            arrays["discs.positions"],
+            arrays["discs.velocities"],
+            arrays["discs.radii"],
+            arrays["discs.masses"],
+            arrays["discs.groups"],
+        )
+        box = Box(**meta["box"])
+        state = dict(meta["state"])
+        state.update({k.removeprefix("state."): v for k, v in arrays.items() if k.startswith("state.")})
+        sim = cls._from_state(discs, box, state)
+        sim.start_time = float(meta["start_time"])
+        sim._run_id = meta["run_id"]
+        sim._stream = meta["stream"]
+        return sim
+
+    @property
+    def events(self) -> np.ndarray:
+        """The recorded event log: a structured array ``(E,)`` of :data:`~discsim.eventlog.EVENT_DTYPE`.
+
+        Empty when the engine was built with ``record=False``.
+
+        Raises:
+            ValueError: if the log was streamed to disk (``run(record_to=...)``):
+                read it with :func:`discsim.read_events`.
+        """
+        self._refuse_if_streamed("events")
+        return super().events
+
+    def trajectory(self, times) -> np.ndarray:
+        """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log.
+
+        Times must lie within ``[start_time, time]``. Needs ``record=True``.
+
+        Raises:
+            ValueError: if the engine does not hold its log (``record=False``, or
+                streamed to disk: use :func:`discsim.trajectory_from_events`).
+            TimeError: if a time lies outside the simulated span.
+        """
+        self._refuse_if_streamed("trajectory()")
+        return super().trajectory(times)
+
+    def _refuse_if_streamed(self, what: str) -> None:
+        if self._stream is not None:
+            path = self._stream["path"]
+            msg = (
+                f"{what} is not kept in memory: this run streamed its event log to {path!r}; "
+                f"read it with ds.read_events({path!r}) and rebuild positions with "
+                f"ds.trajectory_from_events({path!r}, times)"
+            )
+            raise ValueError(msg)
+
     # --- prediction ------------------------------------------------------------------
     def _make_predictor(self, n_pred: int):
         """Build the prediction closures over the state lists (closures read locals fast).
 
-        Returns ``(predict, predict_after_crossing, predictions)``:
+        Returns ``(predict, predictions)``:
 
-        - ``predict(i, t, exclude)`` schedules disc ``i``'s earliest event after
-          time ``t``: its wall hit, its cell crossing, or its collision with a
-          disc in the 3x3 block of cells around it, never with ``exclude`` (the
-          partner it has just left: roundoff must not make a pair collide
-          twice). The earliest collision found is also kept per disc.
-        - ``predict_after_crossing(i, t, direction)`` does the same after ``i``
-          entered a new cell, looking only at the 3 cells that just became
-          adjacent and taking the kept collision for the 6 that stay adjacent.
-          That equals a full 3x3 re-prediction as long as the kept partner has
-          not changed course since; otherwise it falls back to ``predict``.
+        - ``predict(i, t, exclude, direction=-1)`` schedules disc ``i``'s
+          earliest event after time ``t``: its wall or segment hit, its cell
+          crossing, or its collision with a disc in the 3x3 block of cells
+          around it, never with ``exclude`` (the partner it has just left:
+          roundoff must not make a pair collide twice). The earliest collision
+          found is also kept per disc. After ``i`` crossed into a new cell in
+          ``direction``, only the 3 cells that just became adjacent are scanned
+          and the kept collision stands for the 6 that stay adjacent: that
+          equals a full 3x3 re-prediction as long as the kept partner has not
+          changed course since (else the full scan runs).
         - ``predictions()`` counts the predictions made (from ``n_pred``).
 
         The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
@@ -469,7 +754,7 @@ class EventDriven(Engine):
             else:
                 push(i, t_best, (kind, other, 0))
 
-        def predict(i: int, t: float, exclude: int) -> None:
+        def predict(i: int, t: float, exclude: int, direction: int = -1) -> None:
             nonlocal n_pred
             n_pred += 1
             vxi, vyi = vx[i], vy[i]
@@ -478,42 +763,31 @@ class EventDriven(Engine):
             yi = ry[i] + vyi * dti
             ri = radius[i]
             c = cell[i]
-            dt_hit, partner = scan(i, t, exclude, xi, yi, vxi, vyi, ri, zip(blocks[c], shifts[c]))
-            t_hit = t + dt_hit
-            kept_time[i], kept_partner[i] = t_hit, partner
-            if partner >= 0:
-                kept_stamp[i] = count[partner]
-            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, exclude)
-
-        def predict_after_crossing(i: int, t: float, direction: int) -> None:
-            nonlocal n_pred
             partner = kept_partner[i]
-            if partner >= 0 and count[partner] != kept_stamp[i]:
-                predict(i, t, -1)
-                return
-            n_pred += 1
-            vxi, vyi = vx[i], vy[i]
-            dti = t - tr[i]
-            xi = rx[i] + vxi * dti
-            yi = ry[i] + vyi * dti
-            ri = radius[i]
-            c = cell[i]
-            block, shift = blocks[c], shifts[c]
-            k0, k1, k2 = front[direction]
-            dt_new, new_partner = scan(
-                i, t, -1, xi, yi, vxi, vyi, ri, ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2]))
-            )
-            t_hit = kept_time[i]
-            if t + dt_new < t_hit:
-                t_hit = t + dt_new
-                partner = new_partner
-                kept_time[i], kept_partner[i], kept_stamp[i] = t_hit, partner, count[partner]
-            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, -1)
+            if direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i]):
+                # After a crossing: the 3 cells that just became adjacent, and the kept collision.
+                block, shift = blocks[c], shifts[c]
+                k0, k1, k2 = front[direction]
+                dt_new, new_partner = scan(
+                    i, t, exclude, xi, yi, vxi, vyi, ri,
+                    ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2])),
+                )  # fmt: skip
+                t_hit = kept_time[i]
+                if t + dt_new < t_hit:
+                    t_hit, partner = t + dt_new, new_partner
+                    kept_time[i], kept_partner[i], kept_stamp[i] = t_hit, partner, count[partner]
+            else:
+                dt_hit, partner = scan(i, t, exclude, xi, yi, vxi, vyi, ri, zip(blocks[c], shifts[c]))
+                t_hit = t + dt_hit
+                kept_time[i], kept_partner[i] = t_hit, partner
+                if partner >= 0:
+                    kept_stamp[i] = count[partner]
+            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, exclude)
 
         def predictions() -> int:
             return n_pred
 
-        return predict, predict_after_crossing, predictions
+        return predict, predictions
 
     # --- the hot loop ----------------------------------------------------------------
     def _process(self, until: float, limit: int) -> int:
@@ -523,7 +797,7 @@ class EventDriven(Engine):
         """
         queue = self._queue
         pop_before = queue.pop_before
-        predict, predict_after_crossing = self._predict, self._predict_after_crossing
+        predict = self._predict
         rx, ry, vx, vy, tr = self._rx, self._ry, self._vx, self._vy, self._tr
         count, mass, moving = self._count, self._mass, self._moving
         cell, cells, grid = self._cell, self._cells, self.grid
@@ -636,7 +910,7 @@ class EventDriven(Engine):
                 cell[i] = c
                 cells[c].append(i)
                 n_cross += 1
-                predict_after_crossing(i, t, other)
+                predict(i, t, -1, other)
             now = t
             size = len(queue)
             if size > max_queue:

@@ -94,22 +94,28 @@ def reconstruct(
     times = np.atleast_1d(np.asarray(times, dtype=float))
     n = len(positions0)
     # One state record per disc per change: initial state, then each event's i and j.
+    # Each record also keeps the index of its event (-1 for the initial state), so
+    # that a disc changing twice at one time (a chain of contacts) keeps the later state.
     disc = [np.arange(n)]
     t_rec = [np.full(n, float(time0))]
+    seq = [np.full(n, -1)]
     state = [np.hstack([positions0, velocities0])]
     if len(events):
         disc.append(events["i"])
         t_rec.append(events["time"])
+        seq.append(np.arange(len(events)))
         state.append(np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]))
-        pair = events["j"] >= 0
+        pair = np.flatnonzero(events["j"] >= 0)
         ev = events[pair]
         disc.append(ev["j"])
         t_rec.append(ev["time"])
+        seq.append(pair)
         state.append(np.column_stack([ev["xj"], ev["yj"], ev["vxj"], ev["vyj"]]))
     disc = np.concatenate(disc)
     t_rec = np.concatenate(t_rec)
+    seq = np.concatenate(seq)
     state = np.vstack(state)
-    order = np.lexsort((t_rec, disc))  # by disc, then time; stable keeps log order on ties
+    order = np.lexsort((seq, t_rec, disc))  # by disc, then time, then log order
     disc, t_rec, state = disc[order], t_rec[order], state[order]
     starts = np.searchsorted(disc, np.arange(n + 1))
     out = np.empty((len(times), n, 2))

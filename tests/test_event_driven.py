@@ -207,3 +207,14 @@ def test_progress_bar_runs(capsys):
     assert a.time == b.time == 2.0
     c = ds.EventDriven(discs, box).run(events=500, progress=True)
     assert c.counts["collisions"] + c.counts["wall_hits"] == 500
+
+
+def test_trajectory_keeps_the_later_state_when_a_disc_changes_twice_at_one_time():
+    # A cradle of touching discs: the middle disc is hit and passes the momentum on at the same instant.
+    pos = [[2.0, 5.0], [6.0, 5.0], [8.0, 5.0]]
+    sim = ds.EventDriven(ds.Discs(pos, [[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]], 1.0), ds.Box(30.0, 10.0)).run(until=5.0)
+    ev = sim.events
+    assert ev["time"][0] == ev["time"][1] == 2.0  # disc 1 is struck and strikes at t = 2
+    path = sim.trajectory([4.0, 5.0])
+    assert path[:, 1, 0] == pytest.approx([6.0, 6.0])  # the middle disc stays put
+    assert path[:, 2, 0] == pytest.approx([10.0, 11.0])

@@ -14,6 +14,7 @@ The public API::
 """
 
 from discsim import scenarios
+from discsim.checkpoint import checkpoint_info, load, resume
 from discsim.compare import Comparison, compare
 from discsim.engine import Event
 from discsim.errors import (
@@ -27,6 +28,7 @@ from discsim.errors import (
     TimeError,
 )
 from discsim.event_driven import EventDriven
+from discsim.eventlog import StreamedEvents, read_events, trajectory_from_events
 from discsim.fixed_step import FixedStep
 from discsim.observables import compressibility_factor, enskog_collision_rate, henderson_z
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
@@ -49,15 +51,21 @@ __all__ = [
     "OverlapError",
     "PackingError",
     "Scenario",
+    "StreamedEvents",
     "TimeError",
     "billiard_break",
+    "checkpoint_info",
     "compare",
     "compressibility_factor",
     "enskog_collision_rate",
     "head_on",
     "henderson_z",
+    "load",
     "newtons_cradle",
     "random_gas",
+    "read_events",
+    "resume",
     "scenarios",
     "study_cases",
+    "trajectory_from_events",
 ]

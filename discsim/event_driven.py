@@ -402,7 +402,7 @@ class EventDriven(Engine):
             "until": None if limit_t == INF else limit_t,
             "events": None if limit_n < 0 else self._physical() + limit_n,
             "checkpoint_every": every,
-            "record_to": None if writer is None else str(writer.path),
+            "record_to": None if writer is None else str(writer.path.absolute()),
         }
         recording = self.record
         by_time = limit_n < 0
@@ -473,7 +473,7 @@ class EventDriven(Engine):
             writer = RecordWriter.reopen(
                 path, stream["records"], stream["end"], expect={"run_id": stream["run_id"], "base": stream["base"]}
             )
-            self._stream = {**stream, "path": str(path)}
+            self._stream = {**stream, "path": str(path.absolute())}
             return writer
         if stream is None and len(self._log) == physical:
             discs, start, base = self.discs, self.start_time, 0  # the log covers the run from its start
@@ -482,7 +482,13 @@ class EventDriven(Engine):
             self._log.drain()  # events before ``start`` do not belong to the new file
         meta, arrays = stream_header(discs, self.box, start, self._ensure_run_id(), base)
         writer = RecordWriter.create(path, EVENT_DTYPE, meta, arrays)
-        self._stream = {"path": str(path), "run_id": self._run_id, "base": base, "records": 0, "end": writer.end}
+        self._stream = {
+            "path": str(path.absolute()),
+            "run_id": self._run_id,
+            "base": base,
+            "records": 0,
+            "end": writer.end,
+        }
         return writer
 
     def _flush_stream(self, writer: RecordWriter) -> None:

@@ -1,0 +1,510 @@
+"""Files on disk: checksummed state files written atomically, and chunked record streams.
+
+This module knows nothing of discs or engines. A *state file* holds one JSON
+document (``meta``) and named numpy arrays. A *record stream* holds a header
+(the same: JSON and arrays) followed by chunks of records of one structured
+dtype, appended while a run goes on, so that memory stays flat.
+
+Layout (integers little-endian)::
+
+    file  = magic (16 bytes) | format version (uint32) | block [| block ...]
+    block = body length (uint64) | body | SHA-256 of the body (32 bytes)
+    body  = JSON length (uint64) | JSON (UTF-8) | the arrays' bytes, in the order listed
+
+The JSON is ``{"meta": ..., "arrays": [{"name": ..., "descr": ..., "shape": ...}, ...]}``
+with ``descr`` numpy's dtype description (:mod:`numpy.lib.format`). A state
+file has exactly one block; a record stream has a header block and then one
+block per chunk, each checked by its own checksum. Floats in the JSON are
+written with ``repr``, which reads back to the same bits.
+
+Safety: no pickle anywhere. Arrays of Python objects are refused when
+written, and a file can describe only plain numbers and JSON, so reading a
+file never runs code from it.
+
+Crash safety: :func:`write_state` writes to a temporary file in the same
+folder, syncs it and renames it over the target (``os.replace``), so a crash
+leaves either the old file or the new one, never half a file. A stream is
+appended in whole chunks; whoever resumes it truncates it back to a length it
+recorded (:meth:`RecordWriter.reopen`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import struct
+import tempfile
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.lib import format as npformat
+
+from discsim.errors import CheckpointError
+
+__all__ = [
+    "EVENTS_MAGIC",
+    "FORMAT_VERSION",
+    "STATE_MAGIC",
+    "RecordStream",
+    "RecordWriter",
+    "iter_stream",
+    "read_state",
+    "read_stream",
+    "write_state",
+]
+
+#: Version of both layouts; a file of another version is refused.
+FORMAT_VERSION = 1
+#: First 16 bytes of a state file (checkpoint) and of a record stream (event log).
+STATE_MAGIC = b"\x89DISCSIM-STATE\r\n"
+EVENTS_MAGIC = b"\x89DISCSIM-EVENT\r\n"
+
+_PREFIX = struct.Struct("<16sI")  # magic, version
+_LENGTH = struct.Struct("<Q")
+_DIGEST = 32  # SHA-256
+#: A JSON document larger than this is taken for damage rather than read.
+_MAX_JSON = 1 << 28
+
+
+# --- blocks ----------------------------------------------------------------------------------
+def _json_default(value):
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    if isinstance(value, np.bool_):
+        return bool(value)
+    msg = f"cannot store a {type(value).__name__} in a discsim file (only numbers, strings, lists, dicts)"
+    raise TypeError(msg)
+
+
+def _encode_block(meta: dict, arrays: dict[str, np.ndarray]) -> bytes:
+    specs, buffers = [], []
+    for name, value in arrays.items():
+        array = np.ascontiguousarray(value)
+        if array.dtype.hasobject:
+            msg = f"array {name!r} holds Python objects; discsim files hold plain numbers only"
+            raise TypeError(msg)
+        specs.append({"name": name, "descr": npformat.dtype_to_descr(array.dtype), "shape": list(array.shape)})
+        buffers.append(array.tobytes())
+    text = json.dumps({"meta": meta, "arrays": specs}, default=_json_default, separators=(",", ":"))
+    head = text.encode("utf-8")
+    body = b"".join([_LENGTH.pack(len(head)), head, *buffers])
+    return _LENGTH.pack(len(body)) + body + hashlib.sha256(body).digest()
+
+
+def _decode_body(body: bytes, where: str) -> tuple[dict, dict[str, np.ndarray]]:
+    """Meta and arrays of a block body whose checksum has been verified."""
+    try:
+        (json_len,) = _LENGTH.unpack_from(body, 0)
+        if json_len > len(body) - _LENGTH.size:
+            raise ValueError("JSON length beyond the block")
+        doc = json.loads(body[_LENGTH.size : _LENGTH.size + json_len].decode("utf-8"))
+        meta, specs = doc["meta"], doc["arrays"]
+        arrays, offset = {}, _LENGTH.size + json_len
+        for spec in specs:
+            dtype = npformat.descr_to_dtype(spec["descr"])
+            if dtype.hasobject:
+                raise ValueError("an array of Python objects")
+            shape = tuple(int(k) for k in spec["shape"])
+            nbytes = dtype.itemsize * int(np.prod(shape, dtype=np.int64))
+            if offset + nbytes > len(body):
+                raise ValueError(f"array {spec['name']!r} runs past the block")
+            count = nbytes // dtype.itemsize if dtype.itemsize else 0
+            flat = np.frombuffer(body, dtype=dtype, count=count, offset=offset)
+            arrays[spec["name"]] = flat.reshape(shape).copy()
+            offset += nbytes
+        if offset != len(body):
+            raise ValueError(f"{len(body) - offset} unexplained bytes")
+    except (ValueError, KeyError, TypeError, struct.error, UnicodeDecodeError) as exc:
+        # The checksum matched, so the writer itself produced this: not a discsim file.
+        msg = f"{where}: unreadable contents ({exc}); not written by this version of discsim"
+        raise CheckpointError(msg) from exc
+    return meta, arrays
+
+
+def _read_block(handle, where: str, size: int) -> tuple[dict, dict[str, np.ndarray], int] | None:
+    """Read one block at the handle's position; None at a clean end of file.
+
+    Returns ``(meta, arrays, end offset)``. Raises CheckpointError on a
+    truncated or corrupted block. ``size`` is the file's length in bytes.
+    """
+    start = handle.tell()
+    if start == size:
+        return None
+    raw = handle.read(_LENGTH.size)
+    if len(raw) < _LENGTH.size:
+        msg = f"{where}: truncated at byte {start} (an incomplete block header)"
+        raise _Truncated(msg, start)
+    (body_len,) = _LENGTH.unpack(raw)
+    end = start + _LENGTH.size + body_len + _DIGEST
+    if end > size:
+        msg = (
+            f"{where}: truncated at byte {size} (a block starting at byte {start} needs {end - start} bytes; "
+            f"or its length field is corrupted)"
+        )
+        raise _Truncated(msg, start)
+    body = handle.read(body_len)
+    digest = handle.read(_DIGEST)
+    if hashlib.sha256(body).digest() != digest:
+        msg = f"{where}: checksum mismatch in the block at bytes {start}..{end} (the file is corrupted)"
+        raise CheckpointError(msg)
+    meta, arrays = _decode_body(body, where)
+    return meta, arrays, end
+
+
+class _Truncated(CheckpointError):
+    """A block runs past the end of the file; ``offset`` is where that block starts."""
+
+    def __init__(self, message: str, offset: int):
+        super().__init__(message)
+        self.offset = offset
+
+
+def _check_prefix(handle, path, magic: bytes, what: str) -> None:
+    raw = handle.read(_PREFIX.size)
+    if len(raw) < _PREFIX.size:
+        msg = f"{path}: truncated ({len(raw)} bytes), not a complete discsim {what}"
+        raise CheckpointError(msg)
+    found, version = _PREFIX.unpack(raw)
+    if found != magic:
+        msg = f"{path}: not a discsim {what} (wrong leading bytes {found[:16]!r})"
+        raise CheckpointError(msg)
+    if version != FORMAT_VERSION:
+        msg = (
+            f"{path}: format version {version}, but this discsim reads version {FORMAT_VERSION} "
+            "(written by an incompatible discsim, or damaged)"
+        )
+        raise CheckpointError(msg)
+
+
+def _fsync_folder(folder: Path) -> None:
+    """Make a rename durable (POSIX); a no-op where folders cannot be opened."""
+    with contextlib.suppress(OSError):
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+# --- state files -------------------------------------------------------------------------------
+def write_state(path, meta: dict, arrays: dict[str, np.ndarray]) -> Path:
+    """Write a checksummed state file atomically (temporary file, fsync, ``os.replace``).
+
+    Args:
+        path: the file to write; its folder must exist. An existing file is
+            replaced only once the new one is complete on disk.
+        meta: JSON-able dict (numbers, strings, None, lists, dicts; numpy
+            scalars are converted). Floats read back bit for bit.
+        arrays: named numpy arrays of plain (non-object) dtypes.
+
+    Returns:
+        The path written.
+
+    Raises:
+        TypeError: if ``meta`` or ``arrays`` hold something other than plain data.
+
+    Example:
+        >>> import os, tempfile, numpy as np
+        >>> path = os.path.join(tempfile.mkdtemp(), "state.bin")
+        >>> _ = write_state(path, {"time": 0.1}, {"x": np.arange(3.0)})
+        >>> meta, arrays = read_state(path)
+        >>> meta["time"], arrays["x"].tolist()
+        (0.1, [0.0, 1.0, 2.0])
+    """
+    path = Path(path)
+    data = _PREFIX.pack(STATE_MAGIC, FORMAT_VERSION) + _encode_block(meta, arrays)
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    _fsync_folder(folder)
+    return path
+
+
+def read_state(path) -> tuple[dict, dict[str, np.ndarray]]:
+    """Read and verify a file written by :func:`write_state`.
+
+    Returns:
+        ``(meta, arrays)``: the JSON dict and the named arrays (fresh, writable).
+
+    Raises:
+        FileNotFoundError: if there is no such file.
+        CheckpointError: if the file is truncated, corrupted (checksum), not a
+            discsim state file, or of another format version.
+    """
+    path = Path(path)
+    size = path.stat().st_size
+    with open(path, "rb") as handle:
+        _check_prefix(handle, path, STATE_MAGIC, "state file")
+        block = _read_block(handle, str(path), size)
+        if block is None:
+            msg = f"{path}: truncated (no data after the header)"
+            raise CheckpointError(msg)
+        meta, arrays, end = block
+    if end != size:
+        msg = f"{path}: {size - end} unexpected bytes after the data (damaged or not a state file)"
+        raise CheckpointError(msg)
+    return meta, arrays
+
+
+# --- record streams ----------------------------------------------------------------------------
+@dataclass
+class RecordStream:
+    """A record stream read back by :func:`read_stream`.
+
+    Attributes:
+        meta: the header's JSON dict. arrays: the header's named arrays.
+        records: ``(R,)`` every record, in the order written, of ``dtype``.
+        chunks: number of chunks read. end: byte offset after the last chunk read.
+        last: the JSON dict of the last chunk read (empty when there is none).
+    """
+
+    meta: dict
+    arrays: dict[str, np.ndarray]
+    records: np.ndarray
+    chunks: int
+    end: int
+    last: dict
+
+
+def _open_stream(handle, path, size: int) -> tuple[dict, dict[str, np.ndarray], np.dtype, int]:
+    _check_prefix(handle, path, EVENTS_MAGIC, "record stream")
+    header = _read_block(handle, str(path), size)
+    if header is None:
+        msg = f"{path}: truncated (no header after the leading bytes)"
+        raise CheckpointError(msg)
+    meta, arrays, end = header
+    try:
+        dtype = npformat.descr_to_dtype(meta["record_descr"])
+        user = meta["header"]
+    except (KeyError, TypeError, ValueError) as exc:
+        msg = f"{path}: the header does not describe a record stream ({exc})"
+        raise CheckpointError(msg) from exc
+    return user, arrays, dtype, end
+
+
+def iter_stream(path, *, partial: bool = False) -> Iterator[tuple[dict, dict, np.ndarray, int]]:
+    """Walk a record stream chunk by chunk without holding it all in memory.
+
+    Yields ``(header meta, header arrays, no records, end of header)`` first, then
+    ``(chunk meta, {}, records, end offset)`` for each chunk, checking every
+    checksum and that the chunks follow one another.
+
+    Args:
+        path: the stream file.
+        partial: stop quietly before an incomplete last chunk (a run killed
+            while writing) instead of raising. Corruption is refused either way.
+
+    Raises:
+        CheckpointError: truncated (unless ``partial``) or corrupted file,
+            wrong format version, chunks out of order or of the wrong dtype.
+    """
+    path = Path(path)
+    size = path.stat().st_size
+    with open(path, "rb") as handle:
+        user, header_arrays, dtype, end = _open_stream(handle, path, size)
+        yield user, header_arrays, np.zeros(0, dtype=dtype), end
+        expected = 0
+        while True:
+            try:
+                block = _read_block(handle, str(path), size)
+            except _Truncated:
+                if partial:
+                    return
+                raise
+            if block is None:
+                return
+            meta, arrays, end = block
+            records = arrays.get("records")
+            if records is None or records.dtype != dtype or records.ndim != 1:
+                msg = f"{path}: the chunk ending at byte {end} does not hold records of the stream's dtype"
+                raise CheckpointError(msg)
+            if meta.get("first") != expected or meta.get("count") != len(records):
+                msg = (
+                    f"{path}: the chunk ending at byte {end} starts at record {meta.get('first')}, "
+                    f"expected {expected} (chunks missing or out of order)"
+                )
+                raise CheckpointError(msg)
+            expected += len(records)
+            yield meta, {}, records, end
+
+
+def read_stream(path, *, partial: bool = False) -> RecordStream:
+    """Read and verify a whole record stream written by :class:`RecordWriter`.
+
+    Args:
+        path: the stream file.
+        partial: accept an incomplete last chunk (see :func:`iter_stream`).
+
+    Returns:
+        A :class:`RecordStream` with every record concatenated.
+
+    Raises:
+        FileNotFoundError: if there is no such file.
+        CheckpointError: see :func:`iter_stream`.
+
+    Example:
+        >>> import os, tempfile, numpy as np
+        >>> path = os.path.join(tempfile.mkdtemp(), "log.bin")
+        >>> dtype = np.dtype([("t", "f8"), ("i", "i8")])
+        >>> writer = RecordWriter.create(path, dtype, {"n": 2}, {})
+        >>> writer.append(np.array([(0.5, 1), (0.7, 0)], dtype=dtype)); writer.close()
+        >>> stream = read_stream(path)
+        >>> stream.meta, stream.records["i"].tolist(), stream.chunks
+        ({'n': 2}, [1, 0], 1)
+    """
+    walk = iter_stream(path, partial=partial)
+    meta, arrays, empty, end = next(walk)
+    pieces, last = [empty], {}
+    for last, _, records, end in walk:  # noqa: B007 (last and end are used after the loop)
+        pieces.append(records)
+    records = np.concatenate(pieces)
+    return RecordStream(meta, arrays, records, len(pieces) - 1, end, last)
+
+
+class RecordWriter:
+    """Appends chunks of records to a stream file; see the module docstring for the layout.
+
+    Create a new stream with :meth:`create` or continue one with :meth:`reopen`.
+    Each :meth:`append` writes one checksummed chunk and flushes it to the
+    operating system; :meth:`sync` also forces it to the disk (call it before
+    writing a checkpoint that refers to the stream).
+
+    Attributes:
+        path (Path): the file. dtype: the records' dtype.
+        records (int): records in the file so far. end (int): bytes in the file so far.
+    """
+
+    def __init__(self, handle, path: Path, dtype: np.dtype, records: int, end: int):
+        self._handle = handle
+        self.path = path
+        self.dtype = dtype
+        self.records = records
+        self.end = end
+
+    @classmethod
+    def create(cls, path, dtype, meta: dict, arrays: dict[str, np.ndarray]) -> RecordWriter:
+        """Start a new stream at ``path`` with a header (``meta``, ``arrays``); never overwrites.
+
+        Raises:
+            CheckpointError: if ``path`` already exists.
+        """
+        path = Path(path)
+        dtype = np.dtype(dtype)
+        block = _encode_block({"record_descr": npformat.dtype_to_descr(dtype), "header": meta}, arrays)
+        try:
+            handle = open(path, "xb")
+        except FileExistsError as exc:
+            msg = f"{path} already exists; discsim will not overwrite it (choose another path or remove it)"
+            raise CheckpointError(msg) from exc
+        data = _PREFIX.pack(EVENTS_MAGIC, FORMAT_VERSION) + block
+        handle.write(data)
+        handle.flush()
+        return cls(handle, path, dtype, 0, len(data))
+
+    @classmethod
+    def reopen(cls, path, records: int, end: int, expect: dict | None = None) -> RecordWriter:
+        """Continue a stream known to hold ``records`` records in its first ``end`` bytes.
+
+        Checks the header against ``expect`` (items its JSON dict must hold),
+        that chunk boundaries lead exactly to byte ``end``, and that the chunk
+        ending there is intact and ends at record ``records``; only then cuts
+        off whatever follows (chunks written after the checkpoint that
+        recorded ``records`` and ``end``, possibly half a chunk from a killed
+        run).
+
+        Raises:
+            FileNotFoundError: if the file is missing.
+            CheckpointError: if the header is not the expected one, or the file
+                is shorter than ``end``, damaged up to ``end``, or does not hold
+                ``records`` records there. The file is left untouched.
+        """
+        path = Path(path)
+        size = path.stat().st_size
+        if size < end:
+            msg = f"{path}: holds {size} bytes but the checkpoint saw {end} (the log was truncated)"
+            raise CheckpointError(msg)
+        handle = open(path, "r+b")
+        try:
+            user, _, dtype, position = _open_stream(handle, path, size)
+            for key, value in (expect or {}).items():
+                if not isinstance(user, dict) or user.get(key) != value:
+                    found = user.get(key) if isinstance(user, dict) else None
+                    msg = f"{path}: belongs to another run ({key} is {found!r}, expected {value!r})"
+                    raise CheckpointError(msg)
+            last_start = None
+            while position < end:  # follow the length fields; verify only the last chunk
+                raw = handle.read(_LENGTH.size)
+                if len(raw) < _LENGTH.size:
+                    break
+                (body_len,) = _LENGTH.unpack(raw)
+                last_start = position
+                position += _LENGTH.size + body_len + _DIGEST
+                handle.seek(position)
+            if position != end:
+                msg = f"{path}: no chunk ends at byte {end}, where the checkpoint says the log ends (damaged log)"
+                raise CheckpointError(msg)
+            if last_start is None:
+                if records != 0:
+                    msg = f"{path}: holds no chunk but the checkpoint saw {records} records"
+                    raise CheckpointError(msg)
+            else:
+                handle.seek(last_start)
+                meta, chunk, _ = _read_block(handle, str(path), size)
+                got = chunk.get("records")
+                if got is None or got.dtype != dtype or meta.get("first", -1) + len(got) != records:
+                    msg = f"{path}: the chunk ending at byte {end} does not end at record {records} (damaged log)"
+                    raise CheckpointError(msg)
+            handle.seek(end)
+            handle.truncate(end)
+            handle.flush()
+        except BaseException:
+            handle.close()
+            raise
+        return cls(handle, path, dtype, records, end)
+
+    def append(self, records: np.ndarray, meta: dict | None = None) -> None:
+        """Write ``records`` (``(R,)`` of the stream's dtype, possibly empty) as one chunk.
+
+        ``meta`` (JSON-able) is stored with the chunk, next to its ``first``
+        record number and ``count``.
+        """
+        if records.dtype != self.dtype or records.ndim != 1:
+            msg = f"records must be (R,) of {self.dtype}, got shape {records.shape} of {records.dtype}"
+            raise TypeError(msg)
+        data = _encode_block({**(meta or {}), "first": self.records, "count": len(records)}, {"records": records})
+        self._handle.write(data)
+        self._handle.flush()
+        self.records += len(records)
+        self.end += len(data)
+
+    def sync(self) -> None:
+        """Force what was appended onto the disk (``os.fsync``)."""
+        self._handle.flush()
+        os.fsync(self._handle.fileno())
+
+    def close(self) -> None:
+        """Flush and close the file (idempotent)."""
+        if not self._handle.closed:
+            self._handle.flush()
+            self._handle.close()
+
+    def __enter__(self) -> RecordWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

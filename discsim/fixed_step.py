@@ -36,7 +36,7 @@ import math
 import numpy as np
 
 from discsim.engine import Engine, Event
-from discsim.eventlog import EVENT_DTYPE, WALL, EventLog
+from discsim.eventlog import EventLog
 from discsim.grid import CellGrid, check_fits, neighbour_pairs
 from discsim.kernels import resolve_collision
 from discsim.state import Box, Discs
@@ -67,33 +67,6 @@ def _positive_finite(name: str, value) -> float:
         msg = f"{name} must be a positive, finite number, got {value!r}"
         raise ValueError(msg)
     return number
-
-
-def _disc_records(events: np.ndarray) -> np.ndarray:
-    """One wall-kind record per disc state in ``events``, in log order (disc ``i`` before ``j``).
-
-    :func:`discsim.eventlog.reconstruct` takes every record's ``i`` state, then
-    every ``j`` state, before its stable sort by disc and time; so when a disc
-    changes twice at one time, first as ``j`` and then as ``i`` (a chain of
-    pairs in one frame), it keeps the older state. Records that name a single
-    disc each do not have that problem.
-    """
-    pair = events["j"] >= 0
-    rows = np.zeros(len(events) + int(pair.sum()), dtype=EVENT_DTYPE)
-    # Row of each event's i state; its j state (if any) follows at once.
-    first = np.arange(len(events)) + np.concatenate([[0], np.cumsum(pair)[:-1]])
-    second = first[pair] + 1
-    rows["time"][first] = events["time"]
-    rows["time"][second] = events["time"][pair]
-    rows["kind"] = WALL
-    rows["i"][first] = events["i"]
-    rows["i"][second] = events["j"][pair]
-    rows["j"] = -1
-    for a, b in (("xi", "xj"), ("yi", "yj"), ("vxi", "vxj"), ("vyi", "vyj")):
-        rows[a][first] = events[a]
-        rows[a][second] = events[b][pair]
-        rows[b] = np.nan
-    return rows
 
 
 class FixedStep(Engine):
@@ -191,7 +164,6 @@ class FixedStep(Engine):
         self._pos = np.array(discs.positions)  # at the last frame time
         self._frame_time = 0.0
         self._log = EventLog()
-        self._per_disc_records = False
 
     # --- public protocol -------------------------------------------------------------
     @property
@@ -207,23 +179,7 @@ class FixedStep(Engine):
         return self._vel.copy()
 
     def _event_array(self) -> np.ndarray:
-        events = self._log.to_array()
-        return _disc_records(events) if self._per_disc_records else events
-
-    def trajectory(self, times) -> np.ndarray:
-        """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log.
-
-        As :meth:`discsim.engine.Engine.trajectory`; a frame's positions are
-        those after its responses. Times must lie within ``[start_time, time]``.
-        Needs ``record=True``.
-        """
-        # Engine.trajectory validates the times and rebuilds from _event_array(); meanwhile that
-        # array holds one record per disc and state change, in log order (see _disc_records).
-        self._per_disc_records = True
-        try:
-            return super().trajectory(times)
-        finally:
-            self._per_disc_records = False
+        return self._log.to_array()
 
     def frame_time(self, k: int) -> float:
         """The time of frame ``k`` (frame 0 is the start)."""

@@ -136,6 +136,13 @@ def random_gas(
 # --- set pieces: the study's four PIT failures and classic demonstrations -------------------------------
 
 
+def _is_whole(value) -> bool:
+    """True for a finite whole number (an int, or a float such as 5.0), False for anything else."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return False
+    return math.isfinite(value) and int(value) == value
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A ready-made initial condition with the frame rate and horizon to run it at.
@@ -345,7 +352,7 @@ def newtons_cradle(n: int = 5) -> Scenario:
         >>> case.discs.positions[:, 0].tolist()
         [2.0, 6.0, 8.0, 10.0]
     """
-    if isinstance(n, bool) or int(n) != n or n < 2:
+    if not _is_whole(n) or n < 2:
         msg = f"n must be an integer >= 2, got {n!r}"
         raise ValueError(msg)
     n = int(n)
@@ -384,10 +391,10 @@ def billiard_break(rows: int = 5, speed: float = 20.0) -> Scenario:
         >>> len(case.discs), case.discs.velocities[0].tolist()
         (16, [20.0, 0.0])
     """
-    if isinstance(rows, bool) or int(rows) != rows or rows < 1 or rows > 12:
+    if not _is_whole(rows) or not 1 <= rows <= 12:
         msg = f"rows must be an integer in [1, 12], got {rows!r}"
         raise ValueError(msg)
-    if not (speed > 0 and math.isfinite(speed)):
+    if not isinstance(speed, (int, float, np.number)) or not (speed > 0 and math.isfinite(speed)):
         msg = f"speed must be positive and finite, got {speed!r}"
         raise ValueError(msg)
     rows = int(rows)

@@ -1,0 +1,69 @@
+"""The command line: python -m discsim demo."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from discsim import cli
+
+CASES = ["missed_collision", "wrong_direction", "multiple_collisions", "delay"]
+
+
+def test_demo_prints_the_table_and_writes_the_figures(tmp_path, capsys):
+    out = tmp_path / "figures"
+    assert cli.main(["demo", "--out", out]) == 0
+    text = capsys.readouterr().out
+    rows = [line for line in text.splitlines() if line.split() and line.split()[0] in CASES]
+    assert [r.split()[0] for r in rows] == CASES  # one row per case, in the study's order
+    assert "missed 1 collision" in rows[0]
+    assert "direction off by 26.6 deg" in rows[1]
+    assert "missed 1 collision" in rows[2]
+    assert "late by 0.0629" in rows[3]
+    pngs = sorted(p.name for p in out.glob("*.png"))
+    assert pngs == [f"case{k}_{name}.png" for k, name in enumerate(CASES, start=1)]
+    gifs = list(out.glob("*.gif"))
+    assert [g.name for g in gifs] == ["case3_multiple_collisions.gif"]
+    for path in [*out.glob("*.png"), *gifs]:
+        with Image.open(path) as image:
+            assert np.asarray(image.convert("RGB"), dtype=float).std() > 0
+    assert str(out.resolve()) in text
+
+
+def test_demo_without_gif_and_with_another_policy(tmp_path, capsys):
+    assert cli.main(["demo", "--out", str(tmp_path), "--no-gif", "--policy", "revert"]) == 0
+    assert "PIT (revert)" in capsys.readouterr().out
+    assert len(list(tmp_path.glob("*.png"))) == 4 and not list(tmp_path.glob("*.gif"))
+
+
+def test_usage_errors(capsys, tmp_path):
+    assert cli.main([]) == 2  # no command: help, exit code 2
+    assert "demo" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["demo", "--policy", "bounce"])
+    assert exit_info.value.code == 2
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert cli.main(["demo", "--out", blocker / "sub"]) == 1
+    assert "cannot create the output folder" in capsys.readouterr().err
+
+
+def test_each_command_adds_its_own_parser():
+    parser = cli.build_parser()
+    assert parser.parse_args(["demo"]).out == cli.DEFAULT_DEMO_DIR
+    assert cli._add_demo_parser in cli._COMMANDS
+
+
+def test_python_dash_m_discsim_runs():
+    result = subprocess.run(
+        [sys.executable, "-m", "discsim", "demo", "--help"], capture_output=True, text=True, check=False
+    )
+    assert result.returncode == 0 and "--out" in result.stdout

@@ -1,0 +1,120 @@
+"""discsim.plot renders with the Agg backend: each function returns its matplotlib object and draws something."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib import animation
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+from PIL import Image
+
+import discsim as ds
+from discsim import plot
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def assert_not_blank(path):
+    assert path.exists() and path.stat().st_size > 0
+    pixels = np.asarray(Image.open(path).convert("RGB"), dtype=float)
+    assert pixels.std() > 0
+
+
+def case_runs(case):
+    pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate).run(until=case.until)
+    return pic, pit
+
+
+def test_plot_state_of_discs_and_of_an_engine(tmp_path):
+    discs = ds.Discs([[2.0, 2.0], [5.0, 2.0]], [[1.0, 0.5], [0.0, 0.0]], radii=[1.0, 0.5], masses=[1.0, np.inf])
+    ax = plot.plot_state(discs, box=ds.Box(8.0, 4.0))
+    assert isinstance(ax, Axes)
+    (circles,) = [c for c in ax.collections if len(c.get_paths()) == 2]
+    # The obstacle is grey; the moving disc has its own colour.
+    faces = circles.get_facecolor()
+    assert np.allclose(faces[1][:3], 0.55) and not np.allclose(faces[0][:3], 0.55)
+    assert len(ax.patches) == 1  # the box outline
+    assert_not_blank(plot.save_figure(ax, tmp_path / "discs.png"))
+
+    gas, box = ds.random_gas(40, 0.3, seed=1)
+    sim = ds.FixedStep(gas, box, frame_rate=20.0).run(until=0.5)
+    fig, given = plt.subplots()
+    assert plot.plot_state(sim, ax=given) is given
+    assert "t = 0.5" in given.get_title()
+    assert_not_blank(plot.save_figure(fig, tmp_path / "sim.png"))
+
+
+def test_plot_trajectories_draws_one_path_per_disc(tmp_path):
+    gas, box = ds.random_gas(12, 0.2, periodic=True, seed=5)
+    sim = ds.EventDriven(gas, box).run(until=6.0)
+    ax = plot.plot_trajectories(sim)
+    assert len(ax.lines) == 12
+    # Paths that cross the periodic edge are broken there, not drawn across the box.
+    for line in ax.lines:
+        xy = line.get_xydata()
+        finite = np.isfinite(xy).all(axis=1)
+        steps = np.abs(np.diff(xy[finite], axis=0))
+        jumps = ~np.isfinite(xy).all(axis=1)
+        assert (steps.max(initial=0.0) < box.width / 2) or jumps.any()
+    assert_not_blank(plot.save_figure(ax, tmp_path / "paths.png"))
+    assert len(plot.plot_trajectories(sim, discs=[0, 3]).lines) == 2
+    with pytest.raises(IndexError, match="disc index 12"):
+        plot.plot_trajectories(sim, discs=[12])
+
+
+def test_plot_case_draws_pit_and_pic_side_by_side(tmp_path):
+    case = ds.scenarios.multiple_collisions()
+    pic, pit = case_runs(case)
+    fig = plot.plot_case(pic, pit, title=case.name)
+    assert isinstance(fig, Figure)
+    ax_pit, ax_pic = fig.axes
+    assert ax_pit.get_title().startswith("PIT") and ax_pic.get_title().startswith("PIC")
+    # Each exact contact is an unfilled outline of both discs, on both panels (dashed on PIT's).
+    for ax, style in ((ax_pic, "-"), (ax_pit, "--")):
+        outlines = [p for p in ax.patches if isinstance(p, Circle) and not p.get_fill()]
+        assert len(outlines) == 2 * pic.counts["collisions"] == 4
+        assert {p.get_linestyle() for p in outlines} == {style}
+        contacts = pic.events[pic.events["kind"] == 0]
+        expected = sorted(
+            [(float(e["xi"]), float(e["yi"])) for e in contacts] + [(float(e["xj"]), float(e["yj"])) for e in contacts]
+        )
+        np.testing.assert_allclose(sorted(p.center for p in outlines), expected)
+    # One arrow per disc per collision of that run: 2 on PIT's panel, 4 on PIC's.
+    arrows = {ax: sum(len(q.U) for q in ax.collections if isinstance(q, matplotlib.quiver.Quiver)) for ax in fig.axes}
+    assert arrows[ax_pit] == 2 and arrows[ax_pic] == 4
+    assert_not_blank(plot.save_figure(fig, tmp_path / "case3.png"))
+
+
+def test_animate_saves_a_gif_of_two_runs(tmp_path):
+    case = ds.scenarios.delay()
+    pic, pit = case_runs(case)
+    path = tmp_path / "movie" / "delay.gif"
+    anim = plot.animate([pit, pic], path, fps=5)
+    assert isinstance(anim, animation.FuncAnimation)
+    assert_not_blank(path)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 13  # one per PIT frame, 0 to 2.4 every 0.2
+    plot.close(anim)
+
+
+def test_animate_refuses_what_it_cannot_write(tmp_path):
+    case = ds.head_on(1.0, 1.0)
+    sim = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    with pytest.raises(ValueError, match=r"\.gif or \.mp4"):
+        plot.animate(sim, tmp_path / "movie.avi")
+    if not animation.writers.is_available("ffmpeg"):
+        with pytest.raises(RuntimeError, match="ffmpeg"):
+            plot.animate(sim, tmp_path / "movie.mp4")
+    assert not any(tmp_path.iterdir())  # nothing half-written

@@ -435,9 +435,6 @@ class RecordWriter:
         """
         path = Path(path)
         size = path.stat().st_size
-        if size < end:
-            msg = f"{path}: holds {size} bytes but the checkpoint saw {end} (the log was truncated)"
-            raise CheckpointError(msg)
         handle = open(path, "r+b")
         try:
             user, _, dtype, position = _open_stream(handle, path, size)
@@ -446,6 +443,9 @@ class RecordWriter:
                     found = user.get(key) if isinstance(user, dict) else None
                     msg = f"{path}: belongs to another run ({key} is {found!r}, expected {value!r})"
                     raise CheckpointError(msg)
+            if size < end:
+                msg = f"{path}: truncated: holds {size} bytes but the checkpoint saw {end}"
+                raise CheckpointError(msg)
             last_start = None
             while position < end:  # follow the length fields; verify only the last chunk
                 raw = handle.read(_LENGTH.size)

@@ -116,7 +116,7 @@ def _run_demo(args) -> int:
         pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate, policy=args.policy).run(until=case.until)
         report = ds.compare(pic, pit)
         rows.append((case.name, case.frame_rate, report))
-        fig = plot.plot_case(pic, pit, title=f"Case {number}: {case.description}")
+        fig = plot.plot_case(pic, pit, title=f"Case {number}, {case.name}: {case.description}")
         written.append(plot.save_figure(fig, out / f"case{number}_{case.name}.png"))
         if case.name == "multiple_collisions":
             gif_runs = (number, case, pit, pic)
@@ -160,6 +160,10 @@ def main(argv=None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``) and return the exit code.
 
     Exit codes: 0 on success, 1 when the command failed, 2 on a usage error.
+
+    Example:
+        >>> main([])  # no command: prints the help to stderr
+        2
     """
     parser = build_parser()
     args = parser.parse_args(None if argv is None else [str(a) for a in argv])

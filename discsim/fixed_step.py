@@ -155,6 +155,7 @@ class FixedStep(Engine):
         self.counts = {"frames": 0, "pair_tests": 0, "detections": 0, "wall_hits": 0}
         self._cell_size = diameter
         self._radii = np.array(discs.radii)
+        self._radius = discs.radii.tolist()
         self._masses = discs.masses.tolist()
         # Lazy clocks, as in the event log: disc i is at _ref_pos[i] + v (t - _ref_time[i]),
         # so frame positions and trajectory() agree to the last bit.
@@ -188,7 +189,14 @@ class FixedStep(Engine):
         return self.start_time + k * self.dt
 
     def frame_times(self) -> np.ndarray:
-        """Times ``(frames + 1,)`` of the frames done so far, the start included."""
+        """Times ``(frames + 1,)`` of the frames done so far, the start included.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.FixedStep(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], 0.5), ds.Box(4.0, 2.0), frame_rate=4.0)
+            >>> sim.run(until=0.6).frame_times().tolist(), sim.time
+            ([0.0, 0.25, 0.5], 0.6)
+        """
         k = np.arange(self.frames + 1)
         if self._by_rate:
             return self.start_time + k / self.frame_rate
@@ -251,6 +259,14 @@ class FixedStep(Engine):
             The :class:`~discsim.engine.Event` of each response in the frame
             (wall hits first, then disc pairs in the order they were handled);
             empty if nothing touched.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.FixedStep(ds.Discs([[3.0, 1.0]], [[2.0, 0.0]], 0.5), ds.Box(4.0, 2.0), dt=0.5)
+            >>> sim.step()  # x = 4.0: past the wall at 3.5
+            [Event(time=0.5, kind='wall', i=0, j=-1)]
+            >>> sim.velocities.tolist()
+            [[-2.0, 0.0]]
         """
         return self._frame()
 
@@ -351,43 +367,49 @@ class FixedStep(Engine):
         return events
 
     def _respond(self, t, ii, jj, prev, pos, vel) -> list[Event]:
-        """Respond to the overlapping pairs ``ii[k] < jj[k]`` in order; update ``pos`` and ``vel`` in place."""
+        """Respond to the overlapping pairs ``ii[k] < jj[k]`` in order; update ``pos`` and ``vel`` in place.
+
+        The discs involved are read into Python floats once and written back once
+        (a pair sees the velocities left by the pairs before it in the frame).
+        """
         mass = self._masses
-        radii = self._radii
+        radius = self._radius
         periodic = self.box.periodic
         width, height = self.box.width, self.box.height
         policy = self.policy
         log = self._log if self.record else None
-        ref_pos, ref_time = self._ref_pos, self._ref_time
+        involved = np.unique(np.concatenate([ii, jj]))
+        keys = involved.tolist()
+        at = dict(zip(keys, pos[involved].tolist(), strict=True))
+        speed = dict(zip(keys, vel[involved].tolist(), strict=True))
+        before = dict(zip(keys, prev[involved].tolist(), strict=True)) if policy == "revert" else None
+        changed = set()
         events = []
         for i, j in zip(ii, jj, strict=True):
-            xi, yi = pos[i].tolist()
-            xj, yj = pos[j].tolist()
+            xi, yi = at[i]
+            xj, yj = at[j]
             dx, dy = xj - xi, yj - yi
             if periodic:
                 dx -= width * round(dx / width)
                 dy -= height * round(dy / height)
-            vxi, vyi = vel[i].tolist()
-            vxj, vyj = vel[j].tolist()
+            vxi, vyi = speed[i]
+            vxj, vyj = speed[j]
             dvx, dvy = vxj - vxi, vyj - vyi
             if dvx * dx + dvy * dy >= 0.0:  # separating already (an earlier response this frame)
                 continue
             mi, mj = mass[i], mass[j]
             if policy == "revert":
-                pxi, pyi = prev[i].tolist()
-                pxj, pyj = prev[j].tolist()
-                px, py = pxj - pxi, pyj - pyi
+                xi, yi = before[i]
+                xj, yj = before[j]
+                px, py = xj - xi, yj - yi
                 if periodic:
                     px -= width * round(px / width)
                     py -= height * round(py / height)
-                pos[i] = pxi, pyi
-                pos[j] = pxj, pyj
-                xi, yi, xj, yj = pxi, pyi, pxj, pyj
                 if dvx * px + dvy * py < 0.0:  # else keep the frame's line, which is approaching
                     dx, dy = px, py
             elif policy == "separate":
                 dist = math.hypot(dx, dy)
-                depth = radii[i] + radii[j] - dist
+                depth = radius[i] + radius[j] - dist
                 if depth > 0.0 and dist > 0.0:
                     if mi == math.inf:
                         wi, wj = 0.0, 1.0
@@ -398,17 +420,20 @@ class FixedStep(Engine):
                     ux, uy = dx / dist, dy / dist
                     xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
                     xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
-                    pos[i] = xi, yi
-                    pos[j] = xj, yj
                     dx, dy = ux * (dist + depth), uy * (dist + depth)
             uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
-            vel[i] = uxi, uyi
-            vel[j] = uxj, uyj
-            ref_pos[i] = xi, yi
-            ref_pos[j] = xj, yj
-            ref_time[i] = ref_time[j] = t
-            self.counts["detections"] += 1
+            at[i], at[j] = (xi, yi), (xj, yj)
+            speed[i], speed[j] = (uxi, uyi), (uxj, uyj)
+            changed.add(i)
+            changed.add(j)
             events.append(Event(t, "collision", i, j))
             if log is not None:
                 log.collision(t, i, j, xi, yi, uxi, uyi, xj, yj, uxj, uyj)
+        if changed:
+            done = sorted(changed)
+            pos[done] = [at[k] for k in done]
+            vel[done] = [speed[k] for k in done]
+            self._ref_pos[done] = pos[done]
+            self._ref_time[done] = t
+        self.counts["detections"] += len(events)
         return events

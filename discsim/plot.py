@@ -13,6 +13,7 @@ axes have equal aspect.
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -320,7 +321,7 @@ def plot_case(truth, approx, *, title: str | None = None, max_frames: int = 40):
     ]
     fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8, frameon=False)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(textwrap.fill(title, 110), fontsize=11)
     fig.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
     return fig
 
@@ -447,4 +448,8 @@ def save_figure(obj, path, *, dpi: int = 110) -> Path:
 
 def close(obj) -> None:
     """Close the figure of ``obj`` (a Figure, Axes or animation), freeing its memory."""
+    if isinstance(obj, animation.Animation):
+        obj.pause()
+        # Discarded on purpose: spare the "Animation was deleted without rendering anything" warning.
+        obj._draw_was_started = True
     plt.close(_figure_of(obj))

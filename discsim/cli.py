@@ -9,6 +9,9 @@ Commands:
     demo: run the study's four PIT failure cases under PIC (exact) and PIT
         (fixed step), print a comparison table, and write a figure per case
         plus an animation of one case to a folder.
+    run: a long event-driven run of a hard-disc gas with a progress bar,
+        periodic checkpoints, a streamed event log and ``--resume``; prints
+        collisions, collisions/s, energy drift, pressure and Z at the end.
 """
 
 from __future__ import annotations
@@ -134,10 +137,231 @@ def _run_demo(args) -> int:
     return 0
 
 
+# --- run -------------------------------------------------------------------------------------------------
+
+#: Files ``discsim run`` keeps in its output folder.
+RUN_FILES = {
+    "run": "run.json",  # what was asked: identifies the run, so --resume never mixes two runs
+    "checkpoint": "state.dsc",  # the whole state, rewritten every --checkpoint-every events and at the end
+    "events": "events.dse",  # the event log, streamed in checksummed chunks (ds.read_events)
+    "summary": "summary.json",  # the figures printed at the end
+}
+#: Physical events between checkpoints unless ``--checkpoint-every`` says otherwise.
+DEFAULT_CHECKPOINT_EVERY = 1_000_000
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1 or str(value) != text.strip().lstrip("+"):
+        msg = f"expected a positive integer, got {text!r}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        msg = f"expected a positive finite number, got {text!r}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def _add_run_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "run",
+        help="a long event-driven run of a hard-disc gas, with progress, checkpoints and a streamed event log",
+        description=(
+            "Simulate N hard discs at a packing fraction up to a time, streaming every event to "
+            f"OUT/{RUN_FILES['events']} and checkpointing to OUT/{RUN_FILES['checkpoint']}. Killed at any "
+            "moment, the run continues with --resume and ends exactly where it would have ended. At the end "
+            "it prints collisions, collisions/s, the energy drift, the pressure and Z = PA/NkT next to "
+            f"Henderson's equation of state, and writes them to OUT/{RUN_FILES['summary']}."
+        ),
+    )
+    parser.add_argument("--n", type=_positive_int, required=True, help="number of discs")
+    parser.add_argument("--packing", type=_positive_float, required=True, help="packing fraction, in (0, 0.85]")
+    parser.add_argument("--until", type=_positive_float, required=True, help="simulated time to reach")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the initial gas (default 0)")
+    parser.add_argument("--out", required=True, help="folder for the checkpoint, the event log and the summary")
+    parser.add_argument(
+        "--checkpoint-every",
+        type=_positive_int,
+        default=DEFAULT_CHECKPOINT_EVERY,
+        metavar="K",
+        help=f"physical events between checkpoints (default {DEFAULT_CHECKPOINT_EVERY:,})",
+    )
+    parser.add_argument("--resume", action="store_true", help="continue the run already in --out")
+    walls = parser.add_mutually_exclusive_group()
+    walls.add_argument("--periodic", dest="periodic", action="store_true", default=True, help="periodic box (default)")
+    walls.add_argument("--walls", dest="periodic", action="store_false", help="box with reflecting walls")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.set_defaults(func=_cmd_run)
+
+
+def _write_json(path: Path, document: dict) -> None:
+    """Write ``document`` as JSON atomically (temporary file, then ``os.replace``)."""
+    import json
+    import os
+
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(json.dumps(document, indent=2) + "\n")
+    os.replace(tmp, path)
+
+
+def _run_identity(args) -> dict:
+    return {"kind": "discsim run", "n": args.n, "packing": args.packing, "seed": args.seed, "periodic": args.periodic}
+
+
+def _prepare_run_folder(args, out: Path, files: dict) -> str | None:
+    """Check that ``out`` may receive this run; return an error message, or None when it may."""
+    import json
+
+    import discsim as ds
+
+    ours = [files[k].name for k in ("run", "checkpoint", "events", "summary") if files[k].exists()]
+    if ours and not args.resume:
+        return (
+            f"{out} already holds a run ({', '.join(ours)}); add --resume to continue it, "
+            "or choose another --out (nothing was changed)"
+        )
+    if not ours:
+        return None
+    try:
+        recorded = json.loads(files["run"].read_text())
+    except (OSError, ValueError) as exc:
+        return f"{out} holds {', '.join(ours)} but no readable {files['run'].name} ({exc}); not resuming"
+    asked = _run_identity(args)
+    if recorded != asked:
+        diff = ", ".join(
+            f"{k}={recorded.get(k)!r} there, {v!r} asked" for k, v in asked.items() if recorded.get(k) != v
+        )
+        return f"{out} holds a different run ({diff}); choose another --out (nothing was changed)"
+    if not files["checkpoint"].exists() and files["events"].exists():
+        # Killed between creating the log and the first checkpoint: only acceptable if the log is empty.
+        try:
+            if len(ds.read_events(files["events"], partial=True).events):
+                return f"{files['events']} holds events but there is no checkpoint to resume from"
+        except ds.CheckpointError:
+            pass  # not even a complete header: nothing was recorded
+        files["events"].unlink()
+    return None
+
+
+def _run_summary(sim, args, e0: float, collisions0: int, seconds: float, files: dict) -> dict:
+    import discsim as ds
+
+    counts = sim.counts
+    stream = ds.checkpoint_info(files["checkpoint"])["stream"] or {}
+    records = stream.get("records", 0)
+    size = files["events"].stat().st_size if files["events"].exists() else 0
+    return {
+        **_run_identity(args),
+        "until": args.until,
+        "time": sim.time,
+        "collisions": counts["collisions"],
+        "wall_hits": counts["wall_hits"],
+        "session_seconds": seconds,
+        "session_collisions": counts["collisions"] - collisions0,
+        "collisions_per_s": (counts["collisions"] - collisions0) / seconds if seconds > 0 else float("nan"),
+        "energy_drift": (sim.kinetic_energy() - e0) / e0,
+        "max_overlap": sim.max_overlap,
+        "pressure": sim.pressure() if sim.time > 0 else float("nan"),
+        "Z": ds.compressibility_factor(sim) if sim.time > 0 else float("nan"),
+        "henderson_Z": float(ds.henderson_z(args.packing)),
+        "events_on_disk": records,
+        "bytes_per_event": size / records if records else float("nan"),
+        "files": {k: str(v) for k, v in files.items()},
+    }
+
+
+def _print_run_summary(s: dict, resumed: bool) -> None:
+    box = "periodic box" if s["periodic"] else "box with walls"
+    print(
+        f"discsim run: N={s['n']}, packing {s['packing']:g}, {box}, seed {s['seed']}, t = {s['time']:g}"
+        + (" (resumed)" if resumed else "")
+    )
+    rows = [
+        ("collisions", f"{s['collisions']:,}", f"wall hits {s['wall_hits']:,}"),
+        (
+            "collisions/s",
+            f"{s['collisions_per_s']:,.0f}",
+            f"{s['session_collisions']:,} in {s['session_seconds']:.1f} s",
+        ),
+        ("energy drift", f"{s['energy_drift']:.2e}", "relative, since t = 0"),
+        ("deepest overlap", f"{s['max_overlap']:.2e}", "fraction of the contact distance"),
+        ("pressure P", f"{s['pressure']:.6g}", "energy per area, from the collision virial"),
+        ("Z = PA/NkT", f"{s['Z']:.4f}", f"Henderson: {s['henderson_Z']:.4f}"),
+        ("events on disk", f"{s['events_on_disk']:,}", f"{s['bytes_per_event']:.1f} bytes/event"),
+    ]
+    for name, value, note in rows:
+        print(f"  {name:<16}{value:>16}   {note}")
+    print(
+        f"  written to {Path(s['files']['checkpoint']).parent}: " + ", ".join(Path(p).name for p in s["files"].values())
+    )
+
+
+def _cmd_run(args) -> int:
+    import time
+
+    import discsim as ds
+
+    out = Path(args.out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        print(f"discsim run: cannot create the output folder {str(out)!r}: {exc}", file=sys.stderr)
+        return 1
+    files = {key: out / name for key, name in RUN_FILES.items()}
+    problem = _prepare_run_folder(args, out, files)
+    if problem is not None:
+        print(f"discsim run: {problem}", file=sys.stderr)
+        return 1
+    resumed = files["checkpoint"].exists()
+    try:
+        if resumed:
+            sim = ds.load(files["checkpoint"])
+            if args.until < sim.time:
+                print(
+                    f"discsim run: the run in {out} is already at t = {sim.time:g}, past --until {args.until:g}",
+                    file=sys.stderr,
+                )
+                return 1
+        else:
+            discs, box = ds.random_gas(args.n, args.packing, periodic=args.periodic, seed=args.seed)
+            sim = ds.EventDriven(discs, box, record=False)
+            _write_json(files["run"], _run_identity(args))
+        e0, collisions0 = sim.discs.kinetic_energy(), sim.counts["collisions"]
+        start = time.perf_counter()
+        sim.run(
+            until=args.until,
+            progress=not args.no_progress,
+            record_to=files["events"],
+            checkpoint=files["checkpoint"],
+            checkpoint_every=args.checkpoint_every,
+        )
+        seconds = time.perf_counter() - start
+    except ds.DiscsimError as exc:
+        print(f"discsim run: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"\ndiscsim run: interrupted; continue with the same command and --resume (from {out})", file=sys.stderr)
+        return 130
+    summary = _run_summary(sim, args, e0, collisions0, seconds, files)
+    _write_json(files["summary"], summary)
+    _print_run_summary(summary, resumed)
+    return 0
+
+
 # --- the parser ------------------------------------------------------------------------------------------
 
 #: One ``_add_<command>_parser`` per command, in the order ``--help`` lists them.
-_COMMANDS = (_add_demo_parser,)
+_COMMANDS = (_add_demo_parser, _add_run_parser)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -412,6 +412,8 @@ class EventDriven(Engine):
                 self._write_checkpoint(checkpoint, writer, recording, {**target, "finished": False})
             total = limit_t - self.time if by_time else limit_n
             with progress_bar(total, by_time) if progress else contextlib.nullcontext() as bar:
+                if bar is not None:
+                    bar.start(self._counts["collisions"])
                 done = since_checkpoint = 0
                 while True:
                     chunk = self._PROGRESS_CHUNK
@@ -427,12 +429,13 @@ class EventDriven(Engine):
                     since_checkpoint += k
                     if bar is not None:
                         bar.update(self.time - t0 if by_time else k, self._counts["collisions"])
+                    finishing = k < chunk or done == limit_n
                     if writer is not None and len(self._log) >= self.stream_chunk:
                         self._flush_stream(writer)
-                    if every is not None and since_checkpoint >= every:
+                    if every is not None and since_checkpoint >= every and not finishing:  # else the final one
                         self._write_checkpoint(checkpoint, writer, recording, {**target, "finished": False})
                         since_checkpoint = 0
-                    if k < chunk or done == limit_n:
+                    if finishing:
                         break
                 if limit_t != INF and done != limit_n:  # stopped by the clock, not by the event count
                     if bar is not None and by_time:

@@ -24,10 +24,19 @@ class _Bar:
             self._total = total
             self._last_print = 0.0
         else:
-            unit = " time" if by_time else " events"
-            self._tqdm = tqdm(total=total, unit=unit, unit_scale=not by_time, dynamic_ncols=True, file=sys.stderr)
+            if by_time:  # simulated time is a float: show it with a few digits, not all 17
+                bar_format = "{l_bar}{bar}| t = {n:.4g} / {total:.4g} [{elapsed}<{remaining}{postfix}]"
+                self._tqdm = tqdm(total=total, dynamic_ncols=True, file=sys.stderr, bar_format=bar_format)
+            else:
+                self._tqdm = tqdm(total=total, unit=" events", unit_scale=True, dynamic_ncols=True, file=sys.stderr)
+
+    def start(self, collisions: int) -> None:
+        """Count collisions per second from ``collisions`` (the engine's count when the run starts)."""
+        self._collisions0 = collisions
+        self._start = time.perf_counter()
 
     def update(self, amount, collisions: int) -> None:
+        """Advance the bar by ``amount`` (time or events); ``collisions`` is the engine's running count."""
         if self._collisions0 is None:
             self._collisions0 = collisions
         elapsed = max(time.perf_counter() - self._start, 1e-9)

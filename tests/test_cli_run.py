@@ -1,0 +1,180 @@
+"""``discsim run`` end to end (summary, files, refusals, --resume, a SIGKILLed run) and the long-run benchmark."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim.cli import RUN_FILES, main
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _args(out, until=10.0, packing=0.4, n=150, *extra) -> list[str]:
+    return [
+        "run",
+        "--n",
+        str(n),
+        "--packing",
+        str(packing),
+        "--until",
+        str(until),
+        "--seed",
+        "2",
+        "--out",
+        str(out),
+        "--checkpoint-every",
+        "1500",
+        "--no-progress",
+        *extra,
+    ]
+
+
+def _snapshot(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+
+
+def _assert_same_run(a: Path, b: Path) -> None:
+    sa, sb = ds.load(a / RUN_FILES["checkpoint"]), ds.load(b / RUN_FILES["checkpoint"])
+    assert sa.time == sb.time
+    assert sa.positions.tobytes() == sb.positions.tobytes()
+    assert sa.velocities.tobytes() == sb.velocities.tobytes()
+    assert sa.counts == sb.counts and sa.max_overlap == sb.max_overlap and sa.pressure() == sb.pressure()
+    ea, eb = ds.read_events(a / RUN_FILES["events"]), ds.read_events(b / RUN_FILES["events"])
+    assert ea.events.tobytes() == eb.events.tobytes()
+
+
+def test_run_writes_its_files_and_prints_a_summary(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(_args(out)) == 0
+    printed = capsys.readouterr().out
+    for word in ("collisions/s", "energy drift", "pressure P", "Z = PA/NkT", "Henderson: 2.8333"):
+        assert word in printed
+    assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES.values())
+    summary = json.loads((out / RUN_FILES["summary"]).read_text())
+    discs, box = ds.random_gas(150, 0.4, periodic=True, seed=2)
+    same = ds.EventDriven(discs, box, record=False).run(until=10.0)
+    assert summary["collisions"] == same.counts["collisions"] > 1000
+    assert summary["time"] == 10.0 and summary["collisions_per_s"] > 0
+    assert abs(summary["energy_drift"]) < 1e-12
+    assert summary["pressure"] == same.pressure()
+    assert summary["henderson_Z"] == pytest.approx(2.8333, abs=1e-4)
+    assert 0.8 < summary["Z"] / summary["henderson_Z"] < 1.2
+    assert summary["events_on_disk"] == len(ds.read_events(out / RUN_FILES["events"]).events)
+    assert 89.0 < summary["bytes_per_event"] < 100.0  # 89 per event plus the header (the initial discs)
+    assert ds.checkpoint_info(out / RUN_FILES["checkpoint"])["run"]["finished"]
+
+
+def test_run_refuses_a_folder_that_holds_a_run_and_changes_nothing(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(_args(out, until=3.0)) == 0
+    before = _snapshot(out)
+    assert main(_args(out, until=3.0)) == 1
+    assert "already holds a run" in capsys.readouterr().err
+    assert main(_args(out, 3.0, 0.45, 150, "--resume")) == 1
+    assert "holds a different run (packing=0.4 there, 0.45 asked)" in capsys.readouterr().err
+    assert main(_args(out, 3.0, 0.4, 150, "--walls", "--resume")) == 1
+    assert "periodic=True there" in capsys.readouterr().err
+    assert main(_args(out, 2.0, 0.4, 150, "--resume")) == 1
+    assert "past --until" in capsys.readouterr().err
+    (out / RUN_FILES["checkpoint"]).write_bytes(before[RUN_FILES["checkpoint"]][:-7])
+    assert main(_args(out, 5.0, 0.4, 150, "--resume")) == 1
+    assert "truncated" in capsys.readouterr().err
+    after = _snapshot(out)
+    after[RUN_FILES["checkpoint"]] = before[RUN_FILES["checkpoint"]]
+    assert after == before
+
+
+def test_run_resume_extends_a_run_exactly(tmp_path):
+    assert main(_args(tmp_path / "a", until=4.0)) == 0
+    assert main(_args(tmp_path / "a", 9.0, 0.4, 150, "--resume")) == 0
+    assert main(_args(tmp_path / "b", until=9.0)) == 0
+    _assert_same_run(tmp_path / "a", tmp_path / "b")
+    summary = json.loads((tmp_path / "a" / RUN_FILES["summary"]).read_text())
+    assert 0 < summary["session_collisions"] < summary["collisions"]
+
+
+def test_run_with_walls_and_resume_into_an_empty_folder(tmp_path, capsys):
+    out = tmp_path / "walls"
+    assert main(_args(out, 3.0, 0.3, 100, "--walls", "--resume")) == 0  # nothing to resume: starts
+    assert "box with walls" in capsys.readouterr().out
+    summary = json.loads((out / RUN_FILES["summary"]).read_text())
+    assert summary["periodic"] is False and summary["wall_hits"] > 0
+
+
+def test_usage_errors_exit_with_2(capsys):
+    for bad in (["--n", "0"], ["--packing", "-1"], ["--until", "nan"], ["--checkpoint-every", "1.5"]):
+        args = _args("unused")
+        k = args.index(bad[0])
+        args[k + 1] = bad[1]
+        with pytest.raises(SystemExit) as exit_info:
+            main(args)
+        assert exit_info.value.code == 2
+    assert "expected a positive" in capsys.readouterr().err
+
+
+def test_a_killed_cli_run_resumes_to_the_same_end(tmp_path):
+    killed, straight = tmp_path / "killed", tmp_path / "straight"
+    args = _args(killed, 60.0, 0.6, 300)
+    args[args.index("--checkpoint-every") + 1] = "3000"
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    process = subprocess.Popen([sys.executable, "-m", "discsim", *args], stderr=subprocess.PIPE, env=env)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and process.poll() is None:
+            try:
+                if ds.checkpoint_info(killed / RUN_FILES["checkpoint"])["counts"]["collisions"] > 0:
+                    break
+            except (FileNotFoundError, ds.CheckpointError):
+                pass
+            time.sleep(0.005)
+        time.sleep(0.1)
+        process.send_signal(signal.SIGKILL)
+        _, stderr = process.communicate(timeout=30)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == -signal.SIGKILL, stderr.decode()
+    assert not (killed / RUN_FILES["summary"]).exists()
+    assert main([*args, "--resume"]) == 0
+    straight_args = list(args)
+    straight_args[straight_args.index("--out") + 1] = str(straight)
+    assert main(straight_args) == 0
+    _assert_same_run(killed, straight)
+
+
+def test_longrun_benchmark_quick(tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "longrun.py"), "--quick", "--results", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    with open(tmp_path / "longrun_storage.csv", newline="") as handle:
+        storage = list(csv.DictReader(handle))
+    modes = {row["mode"]: row for row in storage}
+    assert set(modes) == {"no log", "in memory", "streamed"}
+    assert 89.0 <= float(modes["streamed"]["bytes_per_event"]) < 95.0
+    assert float(modes["streamed"]["last_fifth_mb"]) < float(modes["in memory"]["last_fifth_mb"])
+    with open(tmp_path / "longrun_dense.csv", newline="") as handle:
+        dense = list(csv.DictReader(handle))
+    assert len(dense) >= 3
+    assert all(float(row["collisions_per_s"]) > 0 for row in dense)
+    assert all(abs(float(row["energy_drift"])) < 1e-9 for row in dense)
+    assert np.all(np.diff([int(row["collisions"]) for row in dense]) > 0)
+    assert (tmp_path / "longrun.png").stat().st_size > 0
+    assert "bytes/event" in done.stdout

@@ -396,6 +396,9 @@ class EventDriven(Engine):
 
         checkpoint = None if checkpoint is None else Path(checkpoint)
         if checkpoint is not None:
+            if record_to is not None and Path(record_to).absolute() == checkpoint.absolute():
+                msg = f"record_to and checkpoint must be two different files, got {checkpoint} twice"
+                raise ValueError(msg)
             self._check_checkpoint_target(checkpoint)
         writer = None if record_to is None else self._open_stream(Path(record_to))
         target = {
@@ -478,13 +481,15 @@ class EventDriven(Engine):
             )
             self._stream = {**stream, "path": str(path.absolute())}
             return writer
-        if stream is None and len(self._log) == physical:
-            discs, start, base = self.discs, self.start_time, 0  # the log covers the run from its start
+        from_start = stream is None and len(self._log) == physical  # the log in memory covers the whole run
+        if from_start:
+            discs, start, base = self.discs, self.start_time, 0
         else:
             discs, start, base = self.snapshot(), self.time, physical
-            self._log.drain()  # events before ``start`` do not belong to the new file
         meta, arrays = stream_header(discs, self.box, start, self._ensure_run_id(), base)
         writer = RecordWriter.create(path, EVENT_DTYPE, meta, arrays)
+        if not from_start:
+            self._log.drain()  # events before ``start`` do not belong to the new file
         self._stream = {
             "path": str(path.absolute()),
             "run_id": self._run_id,

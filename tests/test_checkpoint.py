@@ -198,6 +198,9 @@ def test_run_refuses_a_foreign_or_damaged_checkpoint_and_changes_nothing(tmp_pat
     assert sim.time == 0.0 and sim.counts["collisions"] == 0
     with pytest.raises(FileNotFoundError, match="no folder"):
         sim.run(until=1.0, checkpoint=tmp_path / "missing" / "c.dsc")
+    with pytest.raises(ValueError, match="two different files"):
+        sim.run(until=1.0, checkpoint=tmp_path / "same", record_to=tmp_path / "same")
+    assert not (tmp_path / "same").exists()
 
 
 @pytest.mark.parametrize("every", [0, -3, 2.5, True])

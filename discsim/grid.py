@@ -171,13 +171,18 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
         if nx < 3 or ny < 3:  # tiny periodic box: every pair is a candidate
             nx = ny = 1
     else:
-        nx = max(1, min(int(box.width // cell_size), 4096))
-        ny = max(1, min(int(box.height // cell_size), 4096))
+        nx = max(1, int(box.width // cell_size))
+        ny = max(1, int(box.height // cell_size))
+    if nx * ny > 4 * n + 16:  # few points in a large box: fewer, larger cells
+        scale = math.sqrt(nx * ny / (4 * n + 16))
+        floor_n = 3 if box.periodic else 1
+        nx, ny = max(floor_n, int(nx / scale)), max(floor_n, int(ny / scale))
     cx = np.clip((positions[:, 0] * (nx / box.width)).astype(np.int64), 0, nx - 1)
     cy = np.clip((positions[:, 1] * (ny / box.height)).astype(np.int64), 0, ny - 1)
     cell = cx * ny + cy
     order = np.argsort(cell, kind="stable")
-    sorted_cell = cell[order]
+    cell_start = np.zeros(nx * ny + 1, dtype=np.int64)  # members of cell c: order[cell_start[c]:cell_start[c + 1]]
+    np.cumsum(np.bincount(cell, minlength=nx * ny), out=cell_start[1:])
     rank = np.empty(n, dtype=np.int64)
     rank[order] = np.arange(n)
     parts_i, parts_j = [], []
@@ -193,9 +198,9 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
                 valid = np.ones(n, dtype=bool)
             else:
                 valid = (ox >= 0) & (ox < nx) & (oy < ny)
-            target = ox * ny + oy
-            start = np.searchsorted(sorted_cell, target, side="left")
-            stop = np.searchsorted(sorted_cell, target, side="right")
+            target = np.where(valid, ox * ny + oy, 0)
+            start = cell_start[target]
+            stop = cell_start[target + 1]
             if dx == 0 and dy == 0:
                 start = rank + 1  # same cell: only later members, each pair once
             count = np.where(valid, np.maximum(stop - start, 0), 0)

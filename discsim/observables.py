@@ -27,7 +27,7 @@ def henderson_z(packing_fraction):
     (1975)); within about 0.5% of simulation data for ``eta <= 0.5``.
 
     Example:
-        >>> round(henderson_z(0.5), 4)
+        >>> round(float(henderson_z(0.5)), 4)
         4.125
     """
     eta = np.asarray(packing_fraction, dtype=float)

@@ -201,7 +201,9 @@ class Box:
         """Map positions into the box when periodic; return them unchanged otherwise."""
         if not self.periodic:
             return positions
-        return np.mod(positions, self.size)
+        size = self.size
+        wrapped = np.mod(positions, size)
+        return np.where(wrapped >= size, 0.0, wrapped)  # mod of a tiny negative number rounds up to the size
 
     def displacement(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """``b - a``, with the minimum-image convention when periodic."""

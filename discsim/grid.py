@@ -173,8 +173,9 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
     else:
         nx = max(1, int(box.width // cell_size))
         ny = max(1, int(box.height // cell_size))
-    if nx * ny > 4 * n + 16:  # few points in a large box: fewer, larger cells
-        scale = math.sqrt(nx * ny / (4 * n + 16))
+    max_cells = max(4 * n, 1 << 16)  # bounds the cell-start table when few points share a large box
+    if nx * ny > max_cells:
+        scale = math.sqrt(nx * ny / max_cells)
         floor_n = 3 if box.periodic else 1
         nx, ny = max(floor_n, int(nx / scale)), max(floor_n, int(ny / scale))
     cx = np.clip((positions[:, 0] * (nx / box.width)).astype(np.int64), 0, nx - 1)

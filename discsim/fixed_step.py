@@ -2,19 +2,21 @@
 
 This is the periodic interference test of the study: time advances in frames
 of length ``dt``; after each move the engine looks for pairs of discs that
-overlap and discs that cross a wall, and responds after the fact with one of
-three policies. Between frames discs fly straight, so the event log (one
+overlap and discs that cross a wall or a segment, and responds with one of
+five policies. Between responses discs fly straight, so the event log (one
 record per response, with the state just after it) rebuilds the exact path
 the engine took, and :meth:`~discsim.engine.Engine.trajectory` works as for
 the event-driven engine.
 
-A frame is vectorised with numpy: the move, the wall test, the broad phase
-(:func:`discsim.grid.neighbour_pairs`, or all pairs) and the narrow phase are
-array operations. Only the few pairs found overlapping are visited one by one,
-in a fixed order (by first disc, then second disc), because a disc may sit in
-several of them and each response changes the velocities the next one sees.
+A frame is vectorised with numpy: the move, the wall and segment tests, the
+broad phase (:func:`discsim.grid.neighbour_pairs`, or all pairs) and the
+narrow phase are array operations. Only the few pairs found overlapping are
+visited one by one.
 
-Policies (the issue's names):
+Policies (the issue's names). The first three respond at the frame, after
+the fact, visiting the overlapping pairs in a fixed order (by first disc,
+then second disc), because a disc may sit in several of them and each
+response changes the velocities the next one sees:
 
 - ``"resolve"``: apply the elastic impulse along the line of centres found at
   the frame, to approaching pairs, and leave the discs where they are;
@@ -26,11 +28,50 @@ Policies (the issue's names):
 
 A disc found past a wall and still moving outwards has its normal velocity
 reversed; under ``"revert"`` it goes back to its previous-frame position,
-under ``"separate"`` it is clamped to touch the wall.
+under ``"separate"`` it is clamped to touch the wall. A disc found cutting a
+segment and approaching it is reflected off it
+(:func:`~discsim.kernels.reflect_off_segment`, the normal running from the
+segment's nearest point to the centre); under ``"revert"`` it first goes back
+to its previous-frame position, under ``"separate"`` it is first pushed out
+along the normal to touch the segment.
+
+The other two respond inside the frame, at the contact time (section 3.1 of
+the study, "alternate PIC"). Their candidates (pairs, walls, segments) go into
+a small queue by contact time; each response moves the discs back to the
+contact, applies the impulse there, and lets them finish the frame with their
+new velocities; then the discs that changed course are tested again over the
+rest of the frame against their broad-phase neighbours, the walls and the
+segments (a candidate of a disc that has changed course since is dropped):
+
+- ``"bisect"``: the interference test at the frame, as above; for each
+  overlap found, the frame interval is halved with the same test until the
+  contact is known to ``bisect_tol``
+  (:func:`~discsim.kernels.time_of_impact_bisect`); the response is at the
+  last time found without overlap. Costs ``counts["bisection_tests"]``.
+  A disc that passes right through another (or a segment) between two frames
+  is still missed.
+- ``"swept"``: the swept-volume test: the relative motion of each pair over
+  the frame (the capsule each centre sweeps, seen from the other disc) is
+  tested for a distance below the contact distance, ``min over s in [0, 1]
+  of |d + s dv dt| < sigma``; a disc's path against a segment likewise. The
+  broad phase uses the positions at mid-frame and cells of side
+  ``2 r_max + v_max dt``, which hold every pair that can touch during the
+  frame. The contact time is the analytic root
+  (:func:`~discsim.kernels.time_of_impact`,
+  :func:`~discsim.kernels.segment_time_of_impact`), so fast small discs no
+  longer tunnel (case 1 of the study).
+
+Both stay approximations of the exact engine: contacts that a response inside
+the frame causes with discs outside the frame's broad-phase reach (a disc sped
+up beyond ``v_max``, say) are only found at a later frame.
+
+Collision filtering (``pass_through``) drops the pairs of groups that pass
+through each other before the narrow phase, under every policy.
 """
 
 from __future__ import annotations
 
+import heapq
 import math
 
 import numpy as np
@@ -38,13 +79,22 @@ import numpy as np
 from discsim.engine import Engine, Event
 from discsim.eventlog import EventLog
 from discsim.grid import CellGrid, check_fits, neighbour_pairs
-from discsim.kernels import resolve_collision
-from discsim.state import Box, Discs
+from discsim.kernels import (
+    closest_point_on_segment,
+    reflect_off_segment,
+    resolve_collision,
+    segment_time_of_impact,
+    time_of_impact_bisect,
+    wall_time,
+)
+from discsim.state import Box, Discs, Segment, normalize_pass_through
 
-__all__ = ["BROAD_PHASES", "POLICIES", "FixedStep"]
+__all__ = ["BROAD_PHASES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
 
 #: Response policies of :class:`FixedStep`.
-POLICIES = ("resolve", "revert", "separate")
+POLICIES = ("resolve", "revert", "separate", "bisect", "swept")
+#: The policies that respond at the contact time inside the frame.
+SUB_FRAME_POLICIES = ("bisect", "swept")
 #: Broad phases of :class:`FixedStep`.
 BROAD_PHASES = ("grid", "all-pairs")
 
@@ -52,6 +102,10 @@ BROAD_PHASES = ("grid", "all-pairs")
 DEFAULT_FRAME_RATE = 30.0
 #: Candidate pairs tested at once by the all-pairs broad phase (bounds its memory).
 _ALL_PAIRS_BLOCK = 1 << 21
+#: Default bisection tolerance of the ``"bisect"`` policy, as a fraction of ``dt``.
+DEFAULT_BISECT_FRACTION = 1e-6
+# Kinds of the candidates of a sub-frame policy.
+_PAIR, _WALL, _SEGMENT = 0, 1, 2
 
 
 def _positive_finite(name: str, value) -> float:
@@ -78,16 +132,28 @@ class FixedStep(Engine):
         frame_rate: frames per unit of time (default 30). Give this or ``dt``.
         dt: the frame interval (time units), instead of ``frame_rate``.
         policy: the response to a detected overlap: ``"resolve"`` (default),
-            ``"revert"`` or ``"separate"`` (see the module docstring).
+            ``"revert"``, ``"separate"``, ``"bisect"`` or ``"swept"`` (see the
+            module docstring).
         broad_phase: ``"grid"`` (cell grid, O(N) per frame) or ``"all-pairs"``
             (every pair tested, O(N^2) per frame). Both give identical results.
         record: keep the event log (needed by ``events`` and ``trajectory``).
+        segments: fixed :class:`~discsim.state.Segment` walls (walled boxes
+            only), tested against every disc at each frame (few segments).
+        pass_through: pairs of group labels (``discs.groups``) whose discs do
+            not collide with each other, as for
+            :class:`~discsim.event_driven.EventDriven`. Free when empty.
+        bisect_tol: the ``"bisect"`` policy's tolerance on contact times (time
+            units; default ``1e-6 * dt``).
 
     Raises:
-        ValueError: on a frame rate or ``dt`` that is not a positive finite
-            number, both of them given and disagreeing, or an unknown policy or
-            broad phase.
-        OutsideBoxError, OverlapError: if the discs do not fit in the box.
+        ValueError: on a frame rate, ``dt`` or ``bisect_tol`` that is not a
+            positive finite number, both of ``frame_rate`` and ``dt`` given
+            and disagreeing, an unknown policy or broad phase, or segments in
+            a periodic box.
+        TypeError: if a segment is not a :class:`~discsim.state.Segment`.
+        InvalidDiscsError: on a malformed ``pass_through``.
+        OutsideBoxError, OverlapError: if the discs do not fit in the box (or
+            are cut by a segment).
         BoxTooSmallError: if a periodic box is under three disc diameters a
             side (as for :class:`~discsim.event_driven.EventDriven`).
 
@@ -96,10 +162,17 @@ class FixedStep(Engine):
         dt (float): the frame interval. frame_rate (float): ``1 / dt``.
         frames (int): frames done so far.
         counts (dict[str, int]): ``frames``; ``pair_tests`` (narrow-phase
-            distance checks); ``detections`` (overlapping, approaching pairs
-            that got an impulse); ``wall_hits`` (discs reflected by a wall).
-        max_overlap (float): deepest overlap seen at any frame, as a fraction
-            of the pair's contact distance (0 if discs never overlapped).
+            disc-disc checks: distances at the frame, swept-volume tests, and
+            the tests again after a response inside a frame); ``segment_tests``
+            (disc-segment checks); ``bisection_tests`` (interference tests
+            spent by ``"bisect"``, one at the start of each interval and one
+            per halving); ``detections`` (pairs that got an impulse);
+            ``wall_hits`` (discs reflected by a wall or a segment).
+        max_overlap (float): deepest disc-disc overlap seen, as a fraction of
+            the pair's contact distance (0 if discs never overlapped): at the
+            frames for the first three policies; on the path kept (at contacts
+            and frames) for ``"bisect"`` and ``"swept"``, which undo the
+            overlaps they find.
 
     Example:
         >>> import discsim as ds
@@ -107,6 +180,9 @@ class FixedStep(Engine):
         >>> sim = ds.FixedStep(discs, ds.Box(10.0, 10.0), frame_rate=4.0).run(until=2.5)
         >>> sim.counts["detections"], sim.velocities.tolist(), sim.max_overlap
         (1, [[-1.0, 0.0], [1.0, 0.0]], 0.25)
+        >>> exact = ds.FixedStep(discs, ds.Box(10.0, 10.0), frame_rate=4.0, policy="bisect").run(until=2.5)
+        >>> round(float(exact.events["time"][0]), 6), exact.counts["bisection_tests"], exact.max_overlap
+        (2.0, 21, 0.0)
     """
 
     def __init__(
@@ -119,6 +195,9 @@ class FixedStep(Engine):
         policy: str = "resolve",
         broad_phase: str = "grid",
         record: bool = True,
+        segments=(),
+        pass_through=(),
+        bisect_tol: float | None = None,
     ):
         super().__init__(discs, box, record)
         if dt is None:
@@ -138,7 +217,17 @@ class FixedStep(Engine):
         if broad_phase not in BROAD_PHASES:
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise ValueError(msg)
-        check_fits(discs, box)
+        tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else _positive_finite("bisect_tol", bisect_tol)
+        segments = tuple(segments)
+        for k, segment in enumerate(segments):
+            if not isinstance(segment, Segment):
+                msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
+                raise TypeError(msg)
+        if segments and box.periodic:
+            msg = "segments need a box with walls (periodic=False)"
+            raise ValueError(msg)
+        pass_through = normalize_pass_through(pass_through)
+        check_fits(discs, box, segments=segments, pass_through=pass_through)
         n = len(discs)
         diameter = 2.0 * float(discs.radii.max()) if n else 1.0
         # The same box check as EventDriven's cell grid (a periodic box needs 3 cells a side);
@@ -149,14 +238,37 @@ class FixedStep(Engine):
         self._by_rate = by_rate
         self.policy = policy
         self.broad_phase = broad_phase
+        self.bisect_tol = tol
+        self.segments = segments
+        self.pass_through = pass_through
         self.time = 0.0
         self.frames = 0
         self.max_overlap = 0.0
-        self.counts = {"frames": 0, "pair_tests": 0, "detections": 0, "wall_hits": 0}
+        self.counts = {
+            "frames": 0,
+            "pair_tests": 0,
+            "segment_tests": 0,
+            "bisection_tests": 0,
+            "detections": 0,
+            "wall_hits": 0,
+        }
         self._cell_size = diameter
         self._radii = np.array(discs.radii)
         self._radius = discs.radii.tolist()
         self._masses = discs.masses.tolist()
+        self._moving = np.isfinite(discs.masses).tolist()
+        # Collision filter: pairs (i, j) with _blocked[_group[i], _group[j]] pass through each other.
+        self._blocked = None
+        if pass_through:
+            labels = np.unique(discs.groups)
+            self._group = np.searchsorted(labels, discs.groups)
+            self._blocked = np.array(
+                [[(min(g, h), max(g, h)) in pass_through for h in labels.tolist()] for g in labels.tolist()],
+                dtype=bool,
+            )
+        self._seg_a = np.array([seg.p0 for seg in segments]).reshape(-1, 2)
+        self._seg_b = np.array([seg.p1 for seg in segments]).reshape(-1, 2)
+        self._seg_ends = [(*seg.p0.tolist(), *seg.p1.tolist()) for seg in segments]
         # Lazy clocks, as in the event log: disc i is at _ref_pos[i] + v (t - _ref_time[i]),
         # so frame positions and trajectory() agree to the last bit.
         self._ref_pos = np.array(discs.positions)
@@ -256,9 +368,11 @@ class FixedStep(Engine):
         """Do one frame: move, test, respond.
 
         Returns:
-            The :class:`~discsim.engine.Event` of each response in the frame
-            (wall hits first, then disc pairs in the order they were handled);
-            empty if nothing touched.
+            The :class:`~discsim.engine.Event` of each response in the frame,
+            empty if nothing touched: for ``"resolve"``, ``"revert"`` and
+            ``"separate"`` wall hits first, then segment hits, then disc pairs
+            in the order they were handled, all at the frame time; for
+            ``"bisect"`` and ``"swept"`` in the order of their contact times.
 
         Example:
             >>> import discsim as ds
@@ -278,10 +392,13 @@ class FixedStep(Engine):
         pos = np.mod(pos, size)
         return np.where(pos >= size, pos - size, pos)  # np.mod(-1e-17, L) is L
 
-    def _candidates(self, pos: np.ndarray):
-        """Candidate pairs of the broad phase, as chunks ``(i, j, d)``, ``d`` the minimum-image ``pos[j] - pos[i]``."""
+    def _candidates(self, pos: np.ndarray, cell_size: float | None = None):
+        """Candidate pairs of the broad phase, as chunks ``(i, j, d)``, ``d`` the minimum-image ``pos[j] - pos[i]``.
+
+        Pairs of groups that pass through each other are left out.
+        """
         if self.broad_phase == "grid":
-            yield neighbour_pairs(pos, self._cell_size, self.box)
+            yield self._unblocked(*neighbour_pairs(pos, cell_size or self._cell_size, self.box))
             return
         n = len(pos)
         size = self.box.size
@@ -294,7 +411,14 @@ class FixedStep(Engine):
             d = pos[jj] - pos[ii]
             if self.box.periodic:
                 d -= size * np.round(d / size)
-            yield ii, jj, d
+            yield self._unblocked(ii, jj, d)
+
+    def _unblocked(self, i, j, d):
+        """The pairs of ``(i, j, d)`` whose groups collide (all of them when there is no filter)."""
+        if self._blocked is None or not len(i):
+            return i, j, d
+        keep = ~self._blocked[self._group[i], self._group[j]]
+        return i[keep], j[keep], d[keep]
 
     def _overlapping_pairs(self, pos: np.ndarray):
         """Pairs ``(i, j)`` with ``i < j`` whose discs overlap at ``pos``, sorted by ``i`` then ``j``."""
@@ -324,6 +448,8 @@ class FixedStep(Engine):
         return i[hit], j[hit]
 
     def _frame(self) -> list[Event]:
+        if self.policy in SUB_FRAME_POLICIES:
+            return _SubFrame(self).run()
         k = self.frames + 1
         t = self.frame_time(k)
         prev = self._pos
@@ -354,6 +480,8 @@ class FixedStep(Engine):
                     events.append(Event(t, "wall", i, -1))
                     if record:
                         log.wall(t, i, *pos[i].tolist(), *vel[i].tolist())
+        if self.segments:
+            events.extend(self._segment_hits(t, prev, pos, vel))
         # Disc pairs.
         ii, jj = self._overlapping_pairs(pos)
         if ii:
@@ -364,6 +492,64 @@ class FixedStep(Engine):
         self.time = t
         self.frames = k
         self.counts["frames"] += 1
+        return events
+
+    def _segment_hits(self, t, prev, pos, vel) -> list[Event]:
+        """Respond to discs cutting a segment at ``pos`` (frame policies); update ``pos`` and ``vel`` in place.
+
+        A disc's segments are visited in order, each seeing the position and
+        velocity the one before left (a disc in a corner may touch two).
+        """
+        self.counts["segment_tests"] += len(pos) * len(self.segments)
+        dist = _point_segment_distance(pos[:, None, :], self._seg_a[None], self._seg_b[None])
+        rows, cols = np.nonzero(dist < self._radii[:, None])
+        if not len(rows):
+            return []
+        policy = self.policy
+        radius, ends = self._radius, self._seg_ends
+        log = self._log if self.record else None
+        events = []
+        by_disc: dict[int, list[int]] = {}
+        for i, k in zip(rows.tolist(), cols.tolist()):
+            by_disc.setdefault(i, []).append(k)
+        for i, hits in by_disc.items():
+            x, y = pos[i].tolist()
+            vx, vy = vel[i].tolist()
+            reverted = False
+            responded = False
+            for k in hits:
+                qx, qy = closest_point_on_segment(x, y, *ends[k])
+                nx, ny = x - qx, y - qy
+                if policy == "revert" and not reverted:
+                    px, py = prev[i].tolist()
+                    bx, by = closest_point_on_segment(px, py, *ends[k])
+                    if vx * (px - bx) + vy * (py - by) < 0.0:  # approaching there: reflect at the restored place
+                        x, y, nx, ny = px, py, px - bx, py - by
+                        reverted = True
+                    elif vx * nx + vy * ny < 0.0:  # approaching only at the frame: restore, keep the frame's normal
+                        fx, fy = x, y
+                        x, y = px, py
+                        reverted = True
+                        vx, vy = reflect_off_segment(fx, fy, vx, vy, *ends[k])
+                        responded = True
+                        continue
+                if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
+                    continue
+                if policy == "separate":
+                    dist_k = math.hypot(nx, ny)
+                    if dist_k < radius[i]:
+                        x, y = qx + nx / dist_k * radius[i], qy + ny / dist_k * radius[i]
+                vx, vy = reflect_off_segment(x, y, vx, vy, *ends[k])
+                responded = True
+            if responded:
+                pos[i] = (x, y)
+                vel[i] = (vx, vy)
+                self._ref_pos[i] = (x, y)
+                self._ref_time[i] = t
+                self.counts["wall_hits"] += 1
+                events.append(Event(t, "wall", i, -1))
+                if log is not None:
+                    log.wall(t, i, x, y, vx, vy)
         return events
 
     def _respond(self, t, ii, jj, prev, pos, vel) -> list[Event]:
@@ -437,3 +623,440 @@ class FixedStep(Engine):
             self._ref_time[done] = t
         self.counts["detections"] += len(events)
         return events
+
+
+# --- helpers of the segment tests and the sub-frame policies ------------------------------------------------
+
+
+def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from points ``p`` to segments ``a``-``b`` (broadcast shapes ``(..., 2)``; ``a == b`` allowed)."""
+    e = b - a
+    ee = np.sum(e * e, axis=-1)
+    w = p - a
+    u = np.divide(np.sum(w * e, axis=-1), ee, out=np.zeros(np.broadcast_shapes(ee.shape, w.shape[:-1])), where=ee > 0)
+    u = np.clip(u, 0.0, 1.0)
+    off = w - u[..., None] * e
+    return np.hypot(off[..., 0], off[..., 1])
+
+
+def _segment_segment_distance(p0: np.ndarray, p1: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance ``(N, S)`` between paths ``p0``-``p1`` ``(N, 2)`` and segments ``a``-``b`` ``(S, 2)``."""
+    p0, p1 = p0[:, None, :], p1[:, None, :]
+    a, b = a[None], b[None]
+    dist = np.minimum(
+        np.minimum(_point_segment_distance(p0, a, b), _point_segment_distance(p1, a, b)),
+        np.minimum(_point_segment_distance(a, p0, p1), _point_segment_distance(b, p0, p1)),
+    )
+
+    def cross(u, v):
+        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+    e, f = b - a, p1 - p0
+    crossing = (cross(e, p0 - a) * cross(e, p1 - a) < 0.0) & (cross(f, a - p0) * cross(f, b - p0) < 0.0)
+    return np.where(crossing, 0.0, dist)
+
+
+def _times_of_impact(dx, dy, dvx, dvy, sigma) -> np.ndarray:
+    """:func:`~discsim.kernels.time_of_impact` over arrays (the same floats, element by element)."""
+    b = dx * dvx + dy * dvy
+    c = dx * dx + dy * dy - sigma * sigma
+    a = dvx * dvx + dvy * dvy
+    disc = b * b - a * c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = c / (-b + np.sqrt(np.maximum(disc, 0.0)))
+    toi = np.where(c <= 0.0, 0.0, root)
+    return np.where((b < 0.0) & ((c <= 0.0) | (disc > 0.0)), toi, np.inf)
+
+
+class _SubFrame:
+    """One frame of ``"bisect"`` or ``"swept"``: candidates in contact-time order, responses at the contact.
+
+    Candidates are ``(time, seq, kind, a, b, stamp_a, stamp_b)`` in a heap:
+    ``kind`` is ``_PAIR`` (discs ``a < b``), ``_WALL`` (disc ``a``, wall
+    ``b = 2 * axis + high``) or ``_SEGMENT`` (disc ``a``, segment ``b``); the
+    stamps are the discs' response counts in this frame when the candidate
+    was found, so that a candidate of a disc that has changed course since is
+    dropped (its new path was tested when it changed course).
+    """
+
+    def __init__(self, sim: FixedStep):
+        self.sim = sim
+        self.t0 = sim._frame_time
+        self.k = sim.frames + 1
+        self.t = sim.frame_time(self.k)
+        self.swept = sim.policy == "swept"
+        self.heap: list = []
+        self.seq = 0
+        self.version: dict[int, int] = {}
+        self.events: list[Event] = []
+        self.found: set = set()  # pairs that were candidates, for the overlap at the frame's end
+        self.reach_i = self.reach_j = None
+        self.reach_cell = 0.0
+        self._csr = None
+        self.log = sim._log if sim.record else None
+        box = sim.box
+        self.periodic = box.periodic
+        self.width, self.height = box.width, box.height
+
+    # --- the frame ---------------------------------------------------------------------------------------
+    def run(self) -> list[Event]:
+        sim = self.sim
+        if self.swept:
+            self._detect_swept()
+        else:
+            self._detect_overlaps()
+        heap, version = self.heap, self.version
+        while heap:
+            tc, _, kind, a, b, stamp_a, stamp_b = heapq.heappop(heap)
+            if version.get(a, 0) != stamp_a or (kind == _PAIR and version.get(b, 0) != stamp_b):
+                continue
+            if kind == _PAIR:
+                self._collide(tc, a, b)
+            elif kind == _WALL:
+                self._wall(tc, a, b)
+            else:
+                self._segment(tc, a, b)
+        t = self.t
+        pos = sim._wrap(sim._ref_pos + sim._vel * (t - sim._ref_time)[:, None])
+        if self.found:
+            pairs = np.array(sorted(self.found), dtype=np.int64).reshape(-1, 2)
+            d = pos[pairs[:, 1]] - pos[pairs[:, 0]]
+            if self.periodic:
+                d -= sim.box.size * np.round(d / sim.box.size)
+            depth = 1.0 - np.hypot(d[:, 0], d[:, 1]) / (sim._radii[pairs[:, 0]] + sim._radii[pairs[:, 1]])
+            sim.max_overlap = max(sim.max_overlap, float(depth.max()))
+        sim._pos = pos
+        sim._frame_time = t
+        sim.time = t
+        sim.frames = self.k
+        sim.counts["frames"] += 1
+        return self.events
+
+    def _push(self, tc: float, kind: int, a: int, b: int) -> None:
+        version = self.version
+        stamp_b = version.get(b, 0) if kind == _PAIR else 0
+        heapq.heappush(self.heap, (tc, self.seq, kind, a, b, version.get(a, 0), stamp_b))
+        self.seq += 1
+        if kind == _PAIR:
+            self.found.add((a, b) if a < b else (b, a))
+
+    def _reach(self, pos: np.ndarray, cell: float):
+        """Broad-phase pairs closer than ``cell`` at ``pos``: ``(i, j, d)`` with ``i < j``, sorted by ``(i, j)``."""
+        sim = self.sim
+        parts = []
+        for i, j, d in sim._candidates(pos, cell):
+            sim.counts["pair_tests"] += len(i)
+            near = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] < cell * cell
+            i, j, d = i[near], j[near], d[near]
+            flip = i > j
+            d[flip] = -d[flip]
+            parts.append((np.where(flip, j, i), np.where(flip, i, j), d))
+        if parts:
+            i = np.concatenate([p[0] for p in parts])
+            j = np.concatenate([p[1] for p in parts])
+            d = np.concatenate([p[2] for p in parts])
+        else:
+            i = j = np.zeros(0, dtype=np.int64)
+            d = np.zeros((0, 2))
+        order = np.lexsort((j, i))
+        self.reach_i, self.reach_j, self.reach_cell = i[order], j[order], cell
+        return self.reach_i, self.reach_j, d[order]
+
+    def _neighbours(self, a: int) -> np.ndarray:
+        """The discs that were within the broad phase's reach of disc ``a``, in increasing order."""
+        if self._csr is None:
+            n = len(self.sim._radius)
+            src = np.concatenate([self.reach_i, self.reach_j])
+            dst = np.concatenate([self.reach_j, self.reach_i])
+            order = np.lexsort((dst, src))
+            self._csr = (dst[order], np.searchsorted(src[order], np.arange(n + 1)))
+        dst, starts = self._csr
+        return dst[starts[a] : starts[a + 1]]
+
+    # --- detection at the start of the frame -----------------------------------------------------------
+    def _detect_overlaps(self) -> None:
+        """``"bisect"``: interference tests at the frame, then the contact times by bisection."""
+        sim, t, t0 = self.sim, self.t, self.t0
+        vel, radii = sim._vel, sim._radii
+        pos = sim._wrap(sim._ref_pos + vel * (t - sim._ref_time)[:, None])
+        i, j, d = self._reach(pos, sim._cell_size)
+        contact = radii[i] + radii[j]
+        hit = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] < contact * contact
+        for a, b in zip(i[hit].tolist(), j[hit].tolist()):
+            self._push(self._bisect_pair(a, b, t0), _PAIR, a, b)
+        if not self.periodic:
+            r = radii[:, None]
+            low = (pos < r) & (vel < 0.0)
+            high = (pos > sim.box.size - r) & (vel > 0.0)
+            for a, axis in zip(*np.nonzero(low | high)):
+                wall = 2 * int(axis) + int(high[a, axis])
+                self._push(self._bisect_wall(int(a), wall, t0), _WALL, int(a), wall)
+        if sim.segments:
+            sim.counts["segment_tests"] += len(pos) * len(sim.segments)
+            dist = _point_segment_distance(pos[:, None, :], sim._seg_a[None], sim._seg_b[None])
+            for a, k in zip(*np.nonzero(dist < radii[:, None])):
+                self._push(self._bisect_segment(int(a), int(k), t0), _SEGMENT, int(a), int(k))
+
+    def _detect_swept(self) -> None:
+        """``"swept"``: the relative motion over the frame against the contact distance, then the exact roots."""
+        sim, t, t0 = self.sim, self.t, self.t0
+        span = t - t0
+        vel, radii = sim._vel, sim._radii
+        start = sim._pos  # the positions at t0
+        speed = float(np.sqrt((vel * vel).sum(axis=1)).max()) if len(vel) else 0.0
+        cell = sim._cell_size + speed * span
+        mid = sim._wrap(start + vel * (0.5 * span))
+        i, j, d = self._reach(mid, cell)
+        if len(i):
+            dv = vel[j] - vel[i]
+            d0 = d - dv * (0.5 * span)
+            sweep = dv * span
+            sweep2 = np.sum(sweep * sweep, axis=1)
+            s = np.clip(np.divide(-np.sum(d0 * sweep, axis=1), sweep2, out=np.zeros(len(i)), where=sweep2 > 0), 0, 1)
+            closest = d0 + s[:, None] * sweep
+            contact = radii[i] + radii[j]
+            hit = np.sum(closest * closest, axis=1) < contact * contact
+            if hit.any():
+                toi = _times_of_impact(d0[hit, 0], d0[hit, 1], dv[hit, 0], dv[hit, 1], contact[hit])
+                due = toi <= span
+                for a, b, tau in zip(i[hit][due].tolist(), j[hit][due].tolist(), toi[due].tolist()):
+                    self._push(t0 + tau, _PAIR, a, b)
+        if not self.periodic:
+            for axis, length in ((0, self.width), (1, self.height)):
+                x, v, r = start[:, axis], vel[:, axis], radii
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    wt = np.where(v > 0.0, (length - r - x) / v, np.where(v < 0.0, (r - x) / v, np.inf))
+                for a in np.flatnonzero(wt <= span).tolist():
+                    self._push(t0 + max(float(wt[a]), 0.0), _WALL, a, 2 * axis + int(vel[a, axis] > 0.0))
+        if sim.segments:
+            sim.counts["segment_tests"] += len(start) * len(sim.segments)
+            dist = _segment_segment_distance(start, start + vel * span, sim._seg_a, sim._seg_b)
+            ends = sim._seg_ends
+            for a, k in zip(*np.nonzero(dist < radii[:, None])):
+                a, k = int(a), int(k)
+                tau = segment_time_of_impact(*start[a].tolist(), *vel[a].tolist(), sim._radius[a], *ends[k])
+                if tau <= span:
+                    self._push(t0 + tau, _SEGMENT, a, k)
+
+    # --- paths and contact times ---------------------------------------------------------------------------
+    def _at(self, a: int, s: float) -> tuple[float, float]:
+        """Centre of disc ``a`` at time ``s`` on its current path (not wrapped)."""
+        sim = self.sim
+        x, y = sim._ref_pos[a].tolist()
+        vx, vy = sim._vel[a].tolist()
+        tr = float(sim._ref_time[a])
+        return x + vx * (s - tr), y + vy * (s - tr)
+
+    def _bisect(self, test, s0: float) -> float:
+        """The last time without overlap in ``[s0, t]``, overlap at ``t`` being known; counts the tests."""
+        calls = [1]
+
+        def counted(s: float) -> bool:
+            calls[0] += 1
+            return test(s)
+
+        if test(s0):  # overlapping already where the interval starts: respond there
+            found = s0
+        else:
+            found = time_of_impact_bisect(counted, s0, self.t, self.sim.bisect_tol)
+        self.sim.counts["bisection_tests"] += calls[0]
+        return found
+
+    def _bisect_pair(self, a: int, b: int, s0: float) -> float:
+        sim = self.sim
+        xa, ya = sim._ref_pos[a].tolist()
+        ua, wa = sim._vel[a].tolist()
+        ta = float(sim._ref_time[a])
+        xb, yb = sim._ref_pos[b].tolist()
+        ub, wb = sim._vel[b].tolist()
+        tb = float(sim._ref_time[b])
+        sigma2 = (sim._radius[a] + sim._radius[b]) ** 2
+        periodic, width, height = self.periodic, self.width, self.height
+
+        def overlapping(s: float) -> bool:
+            dx = xb + ub * (s - tb) - (xa + ua * (s - ta))
+            dy = yb + wb * (s - tb) - (ya + wa * (s - ta))
+            if periodic:
+                dx -= width * round(dx / width)
+                dy -= height * round(dy / height)
+            return dx * dx + dy * dy < sigma2
+
+        return self._bisect(overlapping, s0)
+
+    def _bisect_wall(self, a: int, wall: int, s0: float) -> float:
+        sim = self.sim
+        axis, high = divmod(wall, 2)
+        x = float(sim._ref_pos[a, axis])
+        v = float(sim._vel[a, axis])
+        tr = float(sim._ref_time[a])
+        r = sim._radius[a]
+        limit = (self.width if axis == 0 else self.height) - r
+
+        def overlapping(s: float) -> bool:
+            position = x + v * (s - tr)
+            return position > limit if high else position < r
+
+        return self._bisect(overlapping, s0)
+
+    def _bisect_segment(self, a: int, k: int, s0: float) -> float:
+        sim = self.sim
+        x, y = sim._ref_pos[a].tolist()
+        vx, vy = sim._vel[a].tolist()
+        tr = float(sim._ref_time[a])
+        r2 = sim._radius[a] ** 2
+        ends = sim._seg_ends[k]
+
+        def overlapping(s: float) -> bool:
+            px, py = x + vx * (s - tr), y + vy * (s - tr)
+            qx, qy = closest_point_on_segment(px, py, *ends)
+            return (px - qx) ** 2 + (py - qy) ** 2 < r2
+
+        return self._bisect(overlapping, s0)
+
+    # --- responses -----------------------------------------------------------------------------------------
+    def _moved(self, a: int, tc: float, x: float, y: float, vx: float, vy: float) -> None:
+        """Disc ``a`` changed course at ``tc``, at ``(x, y)``: new path from there."""
+        sim = self.sim
+        if self.periodic:
+            x, y = x % self.width, y % self.height
+            if x >= self.width:
+                x -= self.width
+            if y >= self.height:
+                y -= self.height
+        sim._ref_pos[a] = (x, y)
+        sim._ref_time[a] = tc
+        sim._vel[a] = (vx, vy)
+        self.version[a] = self.version.get(a, 0) + 1
+
+    def _collide(self, tc: float, a: int, b: int) -> None:
+        sim = self.sim
+        xa, ya = self._at(a, tc)
+        xb, yb = self._at(b, tc)
+        dx, dy = xb - xa, yb - ya
+        if self.periodic:
+            dx -= self.width * round(dx / self.width)
+            dy -= self.height * round(dy / self.height)
+        vxa, vya = sim._vel[a].tolist()
+        vxb, vyb = sim._vel[b].tolist()
+        if (vxb - vxa) * dx + (vyb - vya) * dy >= 0.0:  # not approaching: nothing to do
+            return
+        sigma = sim._radius[a] + sim._radius[b]
+        sim.max_overlap = max(sim.max_overlap, 1.0 - math.hypot(dx, dy) / sigma)
+        uxa, uya, uxb, uyb = resolve_collision(dx, dy, vxa, vya, vxb, vyb, sim._masses[a], sim._masses[b])
+        moving = sim._moving
+        if moving[a]:
+            self._moved(a, tc, xa, ya, uxa, uya)
+        if moving[b]:
+            self._moved(b, tc, xb, yb, uxb, uyb)
+        sim.counts["detections"] += 1
+        self.events.append(Event(tc, "collision", a, b))
+        if self.log is not None:
+            xa, ya = sim._ref_pos[a].tolist() if moving[a] else (xa, ya)
+            xb, yb = sim._ref_pos[b].tolist() if moving[b] else (xb, yb)
+            self.log.collision(tc, a, b, xa, ya, uxa, uya, xb, yb, uxb, uyb)
+        if moving[a]:
+            self._recheck(a, tc, _PAIR, b)
+        if moving[b]:
+            self._recheck(b, tc, _PAIR, a)
+
+    def _wall(self, tc: float, a: int, wall: int) -> None:
+        sim = self.sim
+        axis, high = divmod(wall, 2)
+        x, y = self._at(a, tc)
+        vx, vy = sim._vel[a].tolist()
+        v = (vx, vy)[axis]
+        if (v <= 0.0) if high else (v >= 0.0):  # moving away from this wall already
+            return
+        if axis == 0:
+            vx = -vx
+        else:
+            vy = -vy
+        self._reflected(tc, a, x, y, vx, vy, _WALL, wall)
+
+    def _segment(self, tc: float, a: int, k: int) -> None:
+        sim = self.sim
+        x, y = self._at(a, tc)
+        vx, vy = sim._vel[a].tolist()
+        ends = sim._seg_ends[k]
+        qx, qy = closest_point_on_segment(x, y, *ends)
+        if vx * (x - qx) + vy * (y - qy) >= 0.0:  # receding
+            return
+        vx, vy = reflect_off_segment(x, y, vx, vy, *ends)
+        self._reflected(tc, a, x, y, vx, vy, _SEGMENT, k)
+
+    def _reflected(self, tc: float, a: int, x: float, y: float, vx: float, vy: float, kind: int, other: int) -> None:
+        sim = self.sim
+        self._moved(a, tc, x, y, vx, vy)
+        sim.counts["wall_hits"] += 1
+        self.events.append(Event(tc, "wall", a, -1))
+        if self.log is not None:
+            self.log.wall(tc, a, *sim._ref_pos[a].tolist(), vx, vy)
+        self._recheck(a, tc, kind, other)
+
+    # --- after a change of course ------------------------------------------------------------------------
+    def _recheck(self, a: int, now: float, kind: int, other: int) -> None:
+        """Test disc ``a``'s new path over ``[now, t]`` against its neighbours, the walls and the segments.
+
+        The partner of the response just made (``kind``, ``other``) is left
+        out: after an elastic response the two separate, and straight paths
+        do not meet again.
+        """
+        sim, t = self.sim, self.t
+        span = t - now
+        radius, vel = sim._radius, sim._vel
+        x, y = sim._ref_pos[a].tolist()
+        vx, vy = vel[a].tolist()
+        r = radius[a]
+        # Discs.
+        if self.reach_i is not None:
+            nb = self._neighbours(a)
+            if kind == _PAIR:
+                nb = nb[nb != other]
+            if len(nb):
+                sim.counts["pair_tests"] += len(nb)
+                pm = sim._ref_pos[nb] + vel[nb] * (now - sim._ref_time[nb])[:, None]
+                d = pm - (x, y)
+                if self.periodic:
+                    d -= sim.box.size * np.round(d / sim.box.size)
+                dv = vel[nb] - (vx, vy)
+                contact = sim._radii[nb] + r
+                if self.swept:
+                    toi = _times_of_impact(d[:, 0], d[:, 1], dv[:, 0], dv[:, 1], contact)
+                    due = toi <= span
+                    for m, tau in zip(nb[due].tolist(), toi[due].tolist()):
+                        self._push(now + tau, _PAIR, min(a, m), max(a, m))
+                else:
+                    end = d + dv * span
+                    hit = np.sum(end * end, axis=1) < contact * contact
+                    for m in nb[hit].tolist():
+                        self._push(self._bisect_pair(a, m, now), _PAIR, min(a, m), max(a, m))
+        # Walls.
+        if not self.periodic:
+            for axis, (p, v, length) in enumerate(((x, vx, self.width), (y, vy, self.height))):
+                wall = 2 * axis + int(v > 0.0)
+                if v == 0.0 or (kind == _WALL and wall == other):
+                    continue
+                if self.swept:
+                    tau = wall_time(p, v, r, length)
+                    if tau <= span:
+                        self._push(now + tau, _WALL, a, wall)
+                else:
+                    end = p + v * span
+                    if (end > length - r) if v > 0.0 else (end < r):
+                        self._push(self._bisect_wall(a, wall, now), _WALL, a, wall)
+        # Segments.
+        ends = sim._seg_ends
+        if ends:
+            sim.counts["segment_tests"] += len(ends)
+            ex, ey = x + vx * span, y + vy * span
+            for k, segment in enumerate(ends):
+                if kind == _SEGMENT and k == other:
+                    continue
+                if self.swept:
+                    tau = segment_time_of_impact(x, y, vx, vy, r, *segment)
+                    if tau <= span:
+                        self._push(now + tau, _SEGMENT, a, k)
+                else:
+                    qx, qy = closest_point_on_segment(ex, ey, *segment)
+                    if (ex - qx) ** 2 + (ey - qy) ** 2 < r * r:
+                        self._push(self._bisect_segment(a, k, now), _SEGMENT, a, k)

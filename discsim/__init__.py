@@ -32,7 +32,7 @@ from discsim.eventlog import StreamedEvents, read_events, trajectory_from_events
 from discsim.fixed_step import FixedStep
 from discsim.observables import compressibility_factor, enskog_collision_rate, henderson_z
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
-from discsim.state import Box, Discs
+from discsim.state import Box, Discs, Segment, polygon
 
 __version__ = "0.1.0"
 
@@ -51,6 +51,7 @@ __all__ = [
     "OverlapError",
     "PackingError",
     "Scenario",
+    "Segment",
     "StreamedEvents",
     "TimeError",
     "billiard_break",
@@ -62,6 +63,7 @@ __all__ = [
     "henderson_z",
     "load",
     "newtons_cradle",
+    "polygon",
     "random_gas",
     "read_events",
     "resume",

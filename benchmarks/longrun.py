@@ -23,7 +23,10 @@ segment (a tenth of the run): collisions/s, the relative energy drift since
 the start, the deepest overlap seen at a collision within the segment
 (``sim.max_overlap``, reset at each segment's start, as a fraction of the
 contact distance), the compressibility factor Z so far and the fraction of
-stale events. None of them may degrade from segment to segment.
+stale events. None of them may degrade from segment to segment. Next to the
+overlap, ``ulp(t) v/2r`` is the resolution of the engine's lazy clocks (one
+unit in the last place of the absolute time, times the rms speed, over the
+contact distance): the floor that roundoff in ``r + v (t - t_ref)`` sets.
 
 Output in ``--results``: ``longrun_storage.csv``, ``longrun_memory.csv``,
 ``longrun_dense.csv`` and ``longrun.png``.
@@ -33,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+import math
 import shutil
 import sys
 import tempfile
@@ -40,6 +44,7 @@ import time
 import tracemalloc
 from pathlib import Path
 
+import numpy as np
 from benchutils import Column, announce, format_table, machine_summary, parse_args, write_csv
 
 import discsim as ds
@@ -144,6 +149,11 @@ STORAGE_COLUMNS = [
 
 
 # --- (b) the hardest density ------------------------------------------------------------------------
+def v_rms(sim) -> float:
+    """Root-mean-square speed of the discs (unit masses)."""
+    return math.sqrt(2.0 * sim.kinetic_energy() / len(sim.discs))
+
+
 def dense(config: Config, folder: Path) -> list[dict]:
     """Section (b): one row per segment of the 0.72 run."""
     discs, box = ds.random_gas(config.dense_n, 0.72, periodic=True, seed=1)
@@ -175,6 +185,9 @@ def dense(config: Config, folder: Path) -> list[dict]:
                 "energy_drift": (sim.kinetic_energy() - e0) / e0,
                 "max_overlap": sim.max_overlap,
                 "max_overlap_so_far": worst,
+                # Resolution of the lazy clocks: positions are r + v (t - t_ref) with t absolute, so
+                # one ulp of t times the rms speed, over the contact distance 2 r (r = 1 here).
+                "clock_resolution": float(np.spacing(sim.time)) * v_rms(sim) / 2.0,
                 "Z": ds.compressibility_factor(sim),
                 "stale_fraction": (counts["stale"] - previous["stale"]) / popped,
                 "log_gb": log.stat().st_size / 1e9,
@@ -198,6 +211,7 @@ DENSE_COLUMNS = [
     Column("collisions_per_cpu_s", "coll/CPU-s", ",.0f"),
     Column("energy_drift", "energy drift", ".2e"),
     Column("max_overlap", "deepest overlap", ".2e"),
+    Column("clock_resolution", "ulp(t) v/2r", ".1e"),
     Column("Z", "Z so far", ".4f"),
     Column("stale_fraction", "stale", ".3f"),
     Column("log_gb", "log GB", ".3f"),
@@ -227,6 +241,7 @@ def plot(memory: list[dict], rows: list[dict], path: Path) -> Path:
         points = [m for m in memory if m["mode"] == mode]
         axes[0].plot([m["events"] for m in points], [m["traced_mb"] for m in points], "o-", label=mode)
     axes[0].set(xlabel="physical events", ylabel="traced memory (MB)", title="(a) memory while recording")
+    axes[0].ticklabel_format(axis="x", style="sci", scilimits=(0, 0))
     axes[0].legend()
     x = [r["collisions"] for r in rows]
     axes[1].plot(x, [r["collisions_per_s"] for r in rows], "o-", label="per wall-clock s")
@@ -235,6 +250,7 @@ def plot(memory: list[dict], rows: list[dict], path: Path) -> Path:
     axes[1].legend()
     axes[2].semilogy(x, [max(abs(r["energy_drift"]), 1e-18) for r in rows], "o-", label="|energy drift|")
     axes[2].semilogy(x, [max(r["max_overlap"], 1e-18) for r in rows], "s-", label="deepest overlap")
+    axes[2].semilogy(x, [r["clock_resolution"] for r in rows], "k:", label="ulp(t) v / 2r (clock resolution)")
     axes[2].set(xlabel="collisions", title="(b) packing 0.72: roundoff per segment")
     axes[2].legend()
     fig.tight_layout()

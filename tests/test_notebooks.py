@@ -49,6 +49,16 @@ def _kernel_manager(kernel_spec_dir):
     return km
 
 
+def test_there_are_notebooks():
+    names = [p.name for p in NOTEBOOKS]
+    assert names[:4] == [
+        "01_pit_vs_pic.ipynb",
+        "02_trajectories.ipynb",
+        "03_when_is_pit_good_enough.ipynb",
+        "04_physics.ipynb",
+    ], names
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_is_committed_without_outputs(path):
     nbformat = pytest.importorskip("nbformat")

@@ -61,9 +61,10 @@ segments (a candidate of a disc that has changed course since is dropped):
   :func:`~discsim.kernels.segment_time_of_impact`), so fast small discs no
   longer tunnel (case 1 of the study).
 
-Both stay approximations of the exact engine: contacts that a response inside
-the frame causes with discs outside the frame's broad-phase reach (a disc sped
-up beyond ``v_max``, say) are only found at a later frame.
+Both stay approximations of the exact engine: ``"bisect"`` sees only the
+contacts that leave an overlap at the frame (after the responses before them),
+and ``"swept"`` follows straight paths from the frame, so it finds a chain of
+contacts inside one frame but takes each disc's course from the last response.
 
 Collision filtering (``pass_through``) drops the pairs of groups that pass
 through each other before the narrow phase, under every policy.
@@ -84,6 +85,7 @@ from discsim.kernels import (
     reflect_off_segment,
     resolve_collision,
     segment_time_of_impact,
+    time_of_impact,
     time_of_impact_bisect,
     wall_time,
 )
@@ -253,12 +255,15 @@ class FixedStep(Engine):
             "wall_hits": 0,
         }
         self._cell_size = diameter
+        self._max_radius = 0.5 * diameter
         self._radii = np.array(discs.radii)
         self._radius = discs.radii.tolist()
         self._masses = discs.masses.tolist()
         self._moving = np.isfinite(discs.masses).tolist()
         # Collision filter: pairs (i, j) with _blocked[_group[i], _group[j]] pass through each other.
         self._blocked = None
+        self._group_list: list[int] = []
+        self._blocked_list: list[list[bool]] = []
         if pass_through:
             labels = np.unique(discs.groups)
             self._group = np.searchsorted(labels, discs.groups)
@@ -266,6 +271,8 @@ class FixedStep(Engine):
                 [[(min(g, h), max(g, h)) in pass_through for h in labels.tolist()] for g in labels.tolist()],
                 dtype=bool,
             )
+            self._group_list = self._group.tolist()
+            self._blocked_list = self._blocked.tolist()
         self._seg_a = np.array([seg.p0 for seg in segments]).reshape(-1, 2)
         self._seg_b = np.array([seg.p1 for seg in segments]).reshape(-1, 2)
         self._seg_ends = [(*seg.p0.tolist(), *seg.p1.tolist()) for seg in segments]
@@ -668,6 +675,67 @@ def _times_of_impact(dx, dy, dvx, dvy, sigma) -> np.ndarray:
     return np.where((b < 0.0) & ((c <= 0.0) | (disc > 0.0)), toi, np.inf)
 
 
+class _CellTable:
+    """Discs by cell of a uniform grid, for box queries (the discs near a path after a change of course).
+
+    Args:
+        pos: ``(N, 2)`` positions (points outside a walled box go to its edge cells).
+        cell: smallest cell side (length); cells grow so that there are at most
+            ``max(4 N, 65536)`` of them.
+        box: the box (a periodic one wraps the queries).
+    """
+
+    def __init__(self, pos: np.ndarray, cell: float, box: Box):
+        n = len(pos)
+        nx = max(1, int(box.width // cell))
+        ny = max(1, int(box.height // cell))
+        cap = max(4 * n, 1 << 16)
+        if nx * ny > cap:
+            scale = math.sqrt(nx * ny / cap)
+            nx, ny = max(1, int(nx / scale)), max(1, int(ny / scale))
+        self.nx, self.ny = nx, ny
+        self.lx, self.ly = box.width / nx, box.height / ny
+        self.periodic = box.periodic
+        cx = np.clip((pos[:, 0] / self.lx).astype(np.int64), 0, nx - 1)
+        cy = np.clip((pos[:, 1] / self.ly).astype(np.int64), 0, ny - 1)
+        cells = cx * ny + cy
+        self.extra: dict[int, list[int]] = {}
+        start = np.zeros(nx * ny + 1, dtype=np.int64)
+        np.cumsum(np.bincount(cells, minlength=nx * ny), out=start[1:])
+        # Plain lists: a query reads a few cells, faster from lists than from numpy.
+        self.order = np.argsort(cells, kind="stable").tolist()
+        self.start = start.tolist()
+
+    def _span(self, lo: float, hi: float, size: float, count: int) -> list[int]:
+        first, last = math.floor(lo / size), math.floor(hi / size)
+        if self.periodic:
+            if last - first + 1 >= count:
+                return list(range(count))
+            return [c % count for c in range(first, last + 1)]
+        return list(range(min(max(first, 0), count - 1), min(max(last, 0), count - 1) + 1))
+
+    def _cells(self, lo: tuple[float, float], hi: tuple[float, float]) -> list[int]:
+        ny = self.ny
+        rows = self._span(lo[1], hi[1], self.ly, ny)
+        return [cx * ny + cy for cx in self._span(lo[0], hi[0], self.lx, self.nx) for cy in rows]
+
+    def add(self, disc: int, lo: tuple[float, float], hi: tuple[float, float]) -> None:
+        """File ``disc`` (which changed course) under the cells that meet the box from ``lo`` to ``hi`` too."""
+        extra = self.extra
+        for c in self._cells(lo, hi):
+            extra.setdefault(c, []).append(disc)
+
+    def near(self, lo: tuple[float, float], hi: tuple[float, float]) -> set[int]:
+        """The discs filed under the cells that meet the box from ``lo`` to ``hi``."""
+        order, start, extra = self.order, self.start, self.extra
+        found: set[int] = set()
+        for c in self._cells(lo, hi):
+            found.update(order[start[c] : start[c + 1]])
+            if c in extra:
+                found.update(extra[c])
+        return found
+
+
 class _SubFrame:
     """One frame of ``"bisect"`` or ``"swept"``: candidates in contact-time order, responses at the contact.
 
@@ -688,11 +756,12 @@ class _SubFrame:
         self.heap: list = []
         self.seq = 0
         self.version: dict[int, int] = {}
+        self.done: dict[tuple[int, int, int], float] = {}  # when each contact was last responded to
         self.events: list[Event] = []
         self.found: set = set()  # pairs that were candidates, for the overlap at the frame's end
-        self.reach_i = self.reach_j = None
-        self.reach_cell = 0.0
-        self._csr = None
+        self.table_pos: np.ndarray | None = None  # where the broad phase saw the discs
+        self.table_reach = 0.0  # how far (length) a disc unchanged in course can be from there
+        self._table: _CellTable | None = None
         self.log = sim._log if sim.record else None
         box = sim.box
         self.periodic = box.periodic
@@ -705,11 +774,16 @@ class _SubFrame:
             self._detect_swept()
         else:
             self._detect_overlaps()
-        heap, version = self.heap, self.version
+        heap, version, done = self.heap, self.version, self.done
         while heap:
             tc, _, kind, a, b, stamp_a, stamp_b = heapq.heappop(heap)
             if version.get(a, 0) != stamp_a or (kind == _PAIR and version.get(b, 0) != stamp_b):
                 continue
+            if done.get((kind, a, b)) == tc:
+                # The same contact again at the same instant: a disc caught overlapping two things (a
+                # wall and a segment, say) would be sent back and forth between them for ever.
+                continue
+            done[(kind, a, b)] = tc
             if kind == _PAIR:
                 self._collide(tc, a, b)
             elif kind == _WALL:
@@ -740,38 +814,63 @@ class _SubFrame:
         if kind == _PAIR:
             self.found.add((a, b) if a < b else (b, a))
 
-    def _reach(self, pos: np.ndarray, cell: float):
-        """Broad-phase pairs closer than ``cell`` at ``pos``: ``(i, j, d)`` with ``i < j``, sorted by ``(i, j)``."""
+    def _pairs(self, pos: np.ndarray, cell: float):
+        """Broad-phase candidate pairs at ``pos``: ``(i, j, d)`` with ``i < j``, sorted by ``(i, j)``."""
         sim = self.sim
         parts = []
         for i, j, d in sim._candidates(pos, cell):
             sim.counts["pair_tests"] += len(i)
-            near = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] < cell * cell
-            i, j, d = i[near], j[near], d[near]
             flip = i > j
             d[flip] = -d[flip]
             parts.append((np.where(flip, j, i), np.where(flip, i, j), d))
-        if parts:
-            i = np.concatenate([p[0] for p in parts])
-            j = np.concatenate([p[1] for p in parts])
-            d = np.concatenate([p[2] for p in parts])
-        else:
-            i = j = np.zeros(0, dtype=np.int64)
-            d = np.zeros((0, 2))
+        if not parts:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
+        i = np.concatenate([p[0] for p in parts])
+        j = np.concatenate([p[1] for p in parts])
+        d = np.concatenate([p[2] for p in parts])
         order = np.lexsort((j, i))
-        self.reach_i, self.reach_j, self.reach_cell = i[order], j[order], cell
-        return self.reach_i, self.reach_j, d[order]
+        return i[order], j[order], d[order]
 
-    def _neighbours(self, a: int) -> np.ndarray:
-        """The discs that were within the broad phase's reach of disc ``a``, in increasing order."""
-        if self._csr is None:
-            n = len(self.sim._radius)
-            src = np.concatenate([self.reach_i, self.reach_j])
-            dst = np.concatenate([self.reach_j, self.reach_i])
-            order = np.lexsort((dst, src))
-            self._csr = (dst[order], np.searchsorted(src[order], np.arange(n + 1)))
-        dst, starts = self._csr
-        return dst[starts[a] : starts[a + 1]]
+    def _near(self, a: int, lo: tuple[float, float], hi: tuple[float, float], partner: int) -> list[int]:
+        """Discs that may touch disc ``a`` in the rest of the frame, sorted; ``a`` and ``partner`` left out.
+
+        ``lo``, ``hi``: corners of a box that holds every point of ``a``'s new
+        path that matters, grown by the largest contact distance and
+        ``table_reach``. Discs are found through a cell table of the broad
+        phase's positions, where each disc that changed course in this frame
+        is also filed under the cells of its new path (see :meth:`_file`).
+        The all-pairs broad phase returns every disc.
+        """
+        sim = self.sim
+        if sim.broad_phase == "all-pairs":
+            near = set(range(len(sim._radius)))
+        else:
+            near = self._cell_table().near(lo, hi)
+        near.discard(a)
+        near.discard(partner)
+        if sim._blocked is not None:
+            group = sim._group_list
+            passes = sim._blocked_list[group[a]]
+            return sorted(m for m in near if not passes[group[m]])
+        return sorted(near)
+
+    def _cell_table(self) -> _CellTable:
+        if self._table is None:
+            self._table = _CellTable(self.table_pos, self.sim._cell_size + self.table_reach, self.sim.box)
+        return self._table
+
+    def _file(self, a: int, now: float) -> None:
+        """File disc ``a``, which changed course at ``now``, under the cells of its new path."""
+        if self.sim.broad_phase == "all-pairs":
+            return
+        x, y = self.sim._ref_pos[a].tolist()
+        vx, vy = self.sim._vel[a].tolist()
+        span = self.t - now
+        ex, ey = x + vx * span, y + vy * span
+        if self.swept:  # the whole path
+            self._cell_table().add(a, (min(x, ex), min(y, ey)), (max(x, ex), max(y, ey)))
+        else:  # where it ends: "bisect" tests at the frame
+            self._cell_table().add(a, (ex, ey), (ex, ey))
 
     # --- detection at the start of the frame -----------------------------------------------------------
     def _detect_overlaps(self) -> None:
@@ -779,7 +878,8 @@ class _SubFrame:
         sim, t, t0 = self.sim, self.t, self.t0
         vel, radii = sim._vel, sim._radii
         pos = sim._wrap(sim._ref_pos + vel * (t - sim._ref_time)[:, None])
-        i, j, d = self._reach(pos, sim._cell_size)
+        self.table_pos = pos
+        i, j, d = self._pairs(pos, sim._cell_size)
         contact = radii[i] + radii[j]
         hit = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] < contact * contact
         for a, b in zip(i[hit].tolist(), j[hit].tolist()):
@@ -806,7 +906,8 @@ class _SubFrame:
         speed = float(np.sqrt((vel * vel).sum(axis=1)).max()) if len(vel) else 0.0
         cell = sim._cell_size + speed * span
         mid = sim._wrap(start + vel * (0.5 * span))
-        i, j, d = self._reach(mid, cell)
+        self.table_pos, self.table_reach = mid, 0.5 * speed * span
+        i, j, d = self._pairs(mid, cell)
         if len(i):
             dv = vel[j] - vel[i]
             d0 = d - dv * (0.5 * span)
@@ -1008,27 +1109,31 @@ class _SubFrame:
         vx, vy = vel[a].tolist()
         r = radius[a]
         # Discs.
-        if self.reach_i is not None:
-            nb = self._neighbours(a)
-            if kind == _PAIR:
-                nb = nb[nb != other]
-            if len(nb):
-                sim.counts["pair_tests"] += len(nb)
-                pm = sim._ref_pos[nb] + vel[nb] * (now - sim._ref_time[nb])[:, None]
-                d = pm - (x, y)
-                if self.periodic:
-                    d -= sim.box.size * np.round(d / sim.box.size)
-                dv = vel[nb] - (vx, vy)
-                contact = sim._radii[nb] + r
-                if self.swept:
-                    toi = _times_of_impact(d[:, 0], d[:, 1], dv[:, 0], dv[:, 1], contact)
-                    due = toi <= span
-                    for m, tau in zip(nb[due].tolist(), toi[due].tolist()):
+        self._file(a, now)
+        ex, ey = x + vx * span, y + vy * span  # where the new path ends
+        grow = 2.0 * sim._max_radius + self.table_reach
+        lo = (min(x, ex) - grow, min(y, ey) - grow) if self.swept else (ex - grow, ey - grow)
+        hi = (max(x, ex) + grow, max(y, ey) + grow) if self.swept else (ex + grow, ey + grow)
+        nb = self._near(a, lo, hi, other if kind == _PAIR else -1)
+        if nb:
+            sim.counts["pair_tests"] += len(nb)
+            periodic, width, height, swept = self.periodic, self.width, self.height, self.swept
+            paths = zip(
+                nb, sim._ref_pos[nb].tolist(), vel[nb].tolist(), sim._ref_time[nb].tolist(), sim._radii[nb].tolist()
+            )
+            for m, (px, py), (ux, uy), tm, rm in paths:
+                dx, dy = px + ux * (now - tm) - x, py + uy * (now - tm) - y
+                if periodic:
+                    dx -= width * round(dx / width)
+                    dy -= height * round(dy / height)
+                dvx, dvy = ux - vx, uy - vy
+                if swept:
+                    tau = time_of_impact(dx, dy, dvx, dvy, r + rm)
+                    if tau <= span:
                         self._push(now + tau, _PAIR, min(a, m), max(a, m))
                 else:
-                    end = d + dv * span
-                    hit = np.sum(end * end, axis=1) < contact * contact
-                    for m in nb[hit].tolist():
+                    gx, gy = dx + dvx * span, dy + dvy * span  # the gap at the frame
+                    if gx * gx + gy * gy < (r + rm) * (r + rm):
                         self._push(self._bisect_pair(a, m, now), _PAIR, min(a, m), max(a, m))
         # Walls.
         if not self.periodic:
@@ -1048,7 +1153,6 @@ class _SubFrame:
         ends = sim._seg_ends
         if ends:
             sim.counts["segment_tests"] += len(ends)
-            ex, ey = x + vx * span, y + vy * span
             for k, segment in enumerate(ends):
                 if kind == _SEGMENT and k == other:
                     continue

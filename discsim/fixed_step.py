@@ -916,7 +916,7 @@ class _SubFrame:
             s = np.clip(np.divide(-np.sum(d0 * sweep, axis=1), sweep2, out=np.zeros(len(i)), where=sweep2 > 0), 0, 1)
             closest = d0 + s[:, None] * sweep
             contact = radii[i] + radii[j]
-            hit = np.sum(closest * closest, axis=1) < contact * contact
+            hit = np.sum(closest * closest, axis=1) <= contact * contact  # touching at the frame counts
             if hit.any():
                 toi = _times_of_impact(d0[hit, 0], d0[hit, 1], dv[hit, 0], dv[hit, 1], contact[hit])
                 due = toi <= span
@@ -933,7 +933,7 @@ class _SubFrame:
             sim.counts["segment_tests"] += len(start) * len(sim.segments)
             dist = _segment_segment_distance(start, start + vel * span, sim._seg_a, sim._seg_b)
             ends = sim._seg_ends
-            for a, k in zip(*np.nonzero(dist < radii[:, None])):
+            for a, k in zip(*np.nonzero(dist <= radii[:, None])):
                 a, k = int(a), int(k)
                 tau = segment_time_of_impact(*start[a].tolist(), *vel[a].tolist(), sim._radius[a], *ends[k])
                 if tau <= span:

@@ -32,6 +32,7 @@ __all__ = [
     "machine_summary",
     "median",
     "parse_args",
+    "peak_resident_mb",
     "time_limit",
     "timed",
     "write_csv",
@@ -184,6 +185,28 @@ def _csv_value(value):
     if isinstance(value, float):
         return repr(value)
     return "" if value is None else value
+
+
+def peak_resident_mb() -> float:
+    """Peak resident memory of this process so far, in MB (NaN if unknown).
+
+    On Linux this is ``VmHWM`` from ``/proc/self/status``: unlike
+    ``resource.ru_maxrss``, which Linux carries over from the parent across
+    ``fork`` and ``exec``, it covers this program alone. Elsewhere ``ru_maxrss``.
+    """
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024  # kB
+    except OSError:
+        pass
+    try:
+        import resource
+    except ImportError:  # Windows
+        return math.nan
+    scale = 1 if sys.platform == "darwin" else 1024  # bytes on macOS, kilobytes on Linux and BSD
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale / 2**20
 
 
 def announce(text: str) -> None:

@@ -19,7 +19,7 @@ Definitions, as printed and written to CSV:
 * ``peak MB``: ``tracemalloc`` peak of Python and numpy allocations while building
   the gas and the engine and equilibrating it, in a separate untimed pass
   (tracemalloc slows Python down, so it never runs during timing).
-* ``RSS MB``: peak resident size (``resource.ru_maxrss``) of a fresh Python
+* ``RSS MB``: peak resident size (:func:`benchutils.peak_resident_mb`) of a fresh Python
   process that imports discsim, builds the same gas and engine and equilibrates
   it: what the operating system sees, interpreter and numpy included (the CSV
   also has ``rss_import_mb``, the peak after the imports alone). This script's
@@ -49,6 +49,7 @@ from benchutils import (
     machine_summary,
     median,
     parse_args,
+    peak_resident_mb,
     timed,
     write_csv,
 )
@@ -186,29 +187,31 @@ def peak_memory_mb(n: int, packing_fraction: float, config: Config) -> float:
 
 
 #: Run in a fresh interpreter by :func:`peak_rss_mb`: prints the peak resident
-#: size (``ru_maxrss``) after the imports and after building and equilibrating.
+#: MB after the imports and after building and equilibrating.
 _RSS_PROBE = """
-import resource, sys
+import sys
+sys.path.insert(0, sys.argv[4])
+from benchutils import peak_resident_mb
 import discsim as ds
 n, phi, events = int(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3])
-scale = 1 if sys.platform == "darwin" else 1024
-after_import = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale
+after_import = peak_resident_mb()
 discs, box = ds.random_gas(n, phi, periodic=True, seed=0)
 ds.EventDriven(discs, box, record=False).run(events=events)
-print(after_import, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale)
+print(after_import, peak_resident_mb())
 """
 
 
 def peak_rss_mb(n: int, packing_fraction: float, config: Config) -> tuple[float, float]:
     """Peak resident MB of a fresh process after importing discsim, and after building and equilibrating.
 
-    Returns NaNs where ``resource`` is missing (Windows) or the probe fails.
+    Returns NaNs where the probe fails.
     """
     events = max(1, round(config.equilibrate_per_disc * n))
-    args = [sys.executable, "-c", _RSS_PROBE, str(n), str(packing_fraction), str(events)]
+    here = str(Path(__file__).resolve().parent)
+    args = [sys.executable, "-c", _RSS_PROBE, str(n), str(packing_fraction), str(events), here]
     try:
         done = subprocess.run(args, capture_output=True, text=True, check=True, timeout=600)
-        after_import, peak = (int(v) / 2**20 for v in done.stdout.split())
+        after_import, peak = (float(v) for v in done.stdout.split())
     except (subprocess.SubprocessError, ValueError, OSError):
         return math.nan, math.nan
     return after_import, peak
@@ -374,19 +377,10 @@ def main(argv=None) -> int:
         print(f"\n== {title} ==")
         outputs[section.__name__] = section(config, args.results)
     png = plot(outputs["pic_throughput_section"], outputs["queue_section"], args.results / "throughput.png")
-    print(f"\nprocess peak resident memory (resource.ru_maxrss): {_max_rss_mb():.0f} MB")
+    print(f"\nthis script's peak resident memory: {peak_resident_mb():.0f} MB")
     print(f"load average at the end: {load_average():.2f}")
     print(f"wrote {args.results / 'throughput.csv'}, {args.results / 'throughput_queue.csv'}, {png}")
     return 0
-
-
-def _max_rss_mb() -> float:
-    try:
-        import resource
-    except ImportError:  # not on Windows
-        return math.nan
-    scale = 1 if sys.platform == "darwin" else 1024  # bytes on macOS, kilobytes on Linux
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale / 2**20
 
 
 if __name__ == "__main__":

@@ -59,7 +59,9 @@ segments (a candidate of a disc that has changed course since is dropped):
   frame. The contact time is the analytic root
   (:func:`~discsim.kernels.time_of_impact`,
   :func:`~discsim.kernels.segment_time_of_impact`), so fast small discs no
-  longer tunnel (case 1 of the study).
+  longer tunnel (case 1 of the study). In a periodic box the minimum image
+  of a pair is taken at mid-frame, so a frame should move a disc less than
+  about a quarter of the box.
 
 Both stay approximations of the exact engine: ``"bisect"`` sees only the
 contacts that leave an overlap at the frame (after the responses before them),
@@ -185,6 +187,10 @@ class FixedStep(Engine):
         >>> exact = ds.FixedStep(discs, ds.Box(10.0, 10.0), frame_rate=4.0, policy="bisect").run(until=2.5)
         >>> round(float(exact.events["time"][0]), 6), exact.counts["bisection_tests"], exact.max_overlap
         (2.0, 21, 0.0)
+        >>> case = ds.scenarios.missed_collision()  # a small fast disc crosses another between frames
+        >>> [ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate, policy=p).run(until=case.until)
+        ...  .counts["detections"] for p in ("resolve", "bisect", "swept")]
+        [0, 0, 1]
     """
 
     def __init__(

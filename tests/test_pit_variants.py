@@ -220,6 +220,23 @@ def test_newtons_cradle_passes_the_momentum_inside_one_frame_under_bisect_and_sw
         assert sim.max_overlap < 1e-12
 
 
+@pytest.mark.parametrize("policy", ["bisect", "swept"])
+@pytest.mark.parametrize("periodic", [False, True])
+def test_infinite_mass_discs_never_move_under_sub_frame_policies(policy, periodic):
+    discs, box = ds.random_gas(60, 0.2, periodic=periodic, seed=5)
+    masses, velocities = np.ones(60), np.array(discs.velocities)
+    masses[:6], velocities[:6] = np.inf, 0.0
+    discs = ds.Discs(discs.positions, velocities, discs.radii, masses)
+    sim = ds.FixedStep(discs, box, frame_rate=4.0, policy=policy)
+    for _ in range(25):
+        sim.step()
+        np.testing.assert_array_equal(sim.positions[:6], discs.positions[:6])
+    assert ((sim.events["j"] >= 0) & (sim.events["i"] < 6)).sum() >= 6  # the obstacles were hit
+    assert sim.kinetic_energy() == pytest.approx(discs.kinetic_energy(), rel=1e-12)
+    path = sim.trajectory(np.linspace(0.0, sim.time, 9))
+    np.testing.assert_array_equal(path[:, :6], np.broadcast_to(discs.positions[:6], (9, 6, 2)))
+
+
 # --- gases: invariants, broad phases, costs ------------------------------------------------------------------------
 
 

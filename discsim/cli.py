@@ -20,6 +20,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from discsim.fixed_step import POLICIES
+
 __all__ = ["build_parser", "main"]
 
 #: Folder the demo writes to unless ``--out`` says otherwise.
@@ -46,8 +48,8 @@ def _add_demo_parser(subparsers) -> None:
     parser.add_argument(
         "--policy",
         default="resolve",
-        choices=["resolve", "revert", "separate"],
-        help="PIT's response to an overlap (default: resolve)",
+        choices=list(POLICIES),
+        help="PIT's response to an overlap (default: resolve; bisect and swept find the contact inside the frame)",
     )
     parser.add_argument("--no-gif", action="store_true", help="skip the animation (faster)")
     parser.set_defaults(func=_run_demo)

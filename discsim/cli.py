@@ -63,7 +63,7 @@ def _failure(report) -> str:
         return f"{report.spurious} spurious collision{'s' if report.spurious > 1 else ''}"
     if report.max_direction_error >= 10.0:
         return f"direction off by {report.max_direction_error:.1f} deg"
-    if report.max_delay > 0:
+    if report.max_delay > 1e-9 * max(1.0, report.horizon):  # beyond roundoff
         return f"late by {report.max_delay:.3g}"
     return "none"
 

@@ -151,7 +151,7 @@ def resume(path, *, progress: bool = False, record_to=None) -> EventDriven:
     info = checkpoint_info(path)
     run = info["run"]
     if run is None:
-        msg = f"{path} was written by save(), not by run(checkpoint=...): there is no run to resume; use load() and run()"
+        msg = f"{path} was written by save(), not by run(checkpoint=...): no run to resume; use load() and run()"
         raise CheckpointError(msg)
     sim = load(path)
     if run["finished"]:

@@ -7,8 +7,10 @@ the notebooks against a different interpreter, with another discsim or none at a
 independent of what is installed where, it writes its own ``python3`` kernel spec into a temporary
 directory, whose command is ``sys.executable -m ipykernel_launcher``, and hands nbclient a
 ``KernelManager`` whose spec manager looks only in that directory. The kernel is then always the very
-interpreter running pytest (the fresh venv of ``.ci/run``), and the test checks that from inside the
-kernel before trusting the run.
+interpreter running pytest (the fresh venv of ``.ci/run``). The kernel also gets the directory holding
+the ``discsim`` package this test imported at the front of ``PYTHONPATH``, so that the notebooks exercise
+the very discsim under test even when another copy is installed in that interpreter. A last cell, added
+in memory, prints the kernel's interpreter and discsim, and the test checks both.
 """
 
 import json
@@ -19,12 +21,14 @@ from pathlib import Path
 
 import pytest
 
+import discsim
+
 NOTEBOOKS_DIR = Path(__file__).resolve().parent.parent / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOKS_DIR.glob("*.ipynb"))
 #: Seconds any one cell may take before the run fails (whole notebooks take 1-2 minutes).
 CELL_TIMEOUT = 600
 
-_PROBE = "import sys as _sys, discsim as _ds\nprint(_sys.executable)\nprint(_ds.__version__)"
+_PROBE = "import sys as _sys, discsim as _ds\nprint(_sys.executable)\nprint(_ds.__file__)"
 
 
 @pytest.fixture(scope="module")
@@ -85,7 +89,9 @@ def test_notebook_runs_top_to_bottom(path, kernel_spec_dir):
         timeout=CELL_TIMEOUT,
         resources={"metadata": {"path": str(NOTEBOOKS_DIR)}},  # the kernel's working directory
     )
-    env = dict(os.environ, MPLBACKEND="Agg")
+    package_root = str(Path(discsim.__file__).resolve().parent.parent)
+    pythonpath = os.pathsep.join(p for p in (package_root, os.environ.get("PYTHONPATH", "")) if p)
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=pythonpath)
     start = time.perf_counter()
     try:
         # Raises CellExecutionError, with the traceback, if any cell fails. nbclient keeps a kernel it
@@ -97,9 +103,8 @@ def test_notebook_runs_top_to_bottom(path, kernel_spec_dir):
     elapsed = time.perf_counter() - start
     print(f"{path.name}: {elapsed:.0f} s")
 
-    import discsim
-
-    probe = "".join(o.get("text", "") for o in nb.cells[-1].outputs if o.output_type == "stream").split()
-    assert probe == [sys.executable, discsim.__version__], probe  # the kernel ran this interpreter
+    probe = "".join(o.get("text", "") for o in nb.cells[-1].outputs if o.output_type == "stream").splitlines()
+    assert probe[0] == sys.executable, probe  # the kernel ran this interpreter...
+    assert Path(probe[1]).resolve() == Path(discsim.__file__).resolve(), probe  # ...and this discsim
     errors = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.outputs if o.output_type == "error"]
     assert not errors

@@ -689,11 +689,27 @@ class EventDriven(Engine):
         segments_near = grid.segments_by_cell(self.segments, reach) if segment_ends else [()] * len(grid)
         sqrt = math.sqrt
 
-        def scan(i, t, exclude, xi, yi, vxi, vyi, ri, cells_and_shifts):
-            """Earliest collision ``(dt, partner)`` of ``i`` with the discs of ``(cell, (sx, sy))`` pairs."""
-            best, partner = INF, -1
+        def predict(i: int, t: float, exclude: int, direction: int = -1) -> None:
+            nonlocal n_pred
+            n_pred += 1
+            vxi, vyi = vx[i], vy[i]
+            dti = t - tr[i]
+            xi = rx[i] + vxi * dti
+            yi = ry[i] + vyi * dti
+            ri = radius[i]
+            c = cell[i]
+            # 1. The earliest collision with a neighbour.
+            partner = kept_partner[i]
+            after_crossing = direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i])
+            if after_crossing:  # the 3 cells that just became adjacent; the kept collision covers the other 6
+                block, shift = blocks[c], shifts[c]
+                k0, k1, k2 = front[direction]
+                near = ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2]))
+            else:
+                near = zip(blocks[c], shifts[c])
+            best, new_partner = INF, -1
             passes = blocked[group[i]] if filtering else None
-            for members, (sx, sy) in cells_and_shifts:
+            for members, (sx, sy) in near:
                 if not members:
                     continue
                 ox, oy = sx - xi, sy - yi
@@ -719,11 +735,18 @@ class EventDriven(Engine):
                             continue
                         tij = cc / (-b + sqrt(disc))
                     if tij < best:
-                        best, partner = tij, j
-            return best, partner
-
-        def schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, exclude):
-            """Push the earlier of the collision at absolute ``t_hit`` and the next wall, segment or crossing."""
+                        best, new_partner = tij, j
+            if after_crossing:
+                t_hit = kept_time[i]
+                if t + best < t_hit:
+                    t_hit, partner = t + best, new_partner
+                    kept_time[i], kept_partner[i], kept_stamp[i] = t_hit, partner, count[partner]
+            else:
+                t_hit, partner = t + best, new_partner
+                kept_time[i], kept_partner[i] = t_hit, partner
+                if partner >= 0:
+                    kept_stamp[i] = count[partner]
+            # 2. The next wall, segment or cell boundary.
             best, kind, other = INF, _CROSSING, 0
             if vxi > 0.0:
                 if wall_xhi[c]:
@@ -760,6 +783,7 @@ class EventDriven(Engine):
                         best, kind, other = ts, _SEGMENT, k
             if best < 0.0:
                 best = 0.0
+            # 3. Schedule the earlier of the two.
             t_best = t + best
             if t_hit <= t_best and partner >= 0:
                 push(i, t_hit, (_COLLISION, partner, count[partner]))
@@ -767,36 +791,6 @@ class EventDriven(Engine):
                 discard(i)
             else:
                 push(i, t_best, (kind, other, 0))
-
-        def predict(i: int, t: float, exclude: int, direction: int = -1) -> None:
-            nonlocal n_pred
-            n_pred += 1
-            vxi, vyi = vx[i], vy[i]
-            dti = t - tr[i]
-            xi = rx[i] + vxi * dti
-            yi = ry[i] + vyi * dti
-            ri = radius[i]
-            c = cell[i]
-            partner = kept_partner[i]
-            if direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i]):
-                # After a crossing: the 3 cells that just became adjacent, and the kept collision.
-                block, shift = blocks[c], shifts[c]
-                k0, k1, k2 = front[direction]
-                dt_new, new_partner = scan(
-                    i, t, exclude, xi, yi, vxi, vyi, ri,
-                    ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2])),
-                )  # fmt: skip
-                t_hit = kept_time[i]
-                if t + dt_new < t_hit:
-                    t_hit, partner = t + dt_new, new_partner
-                    kept_time[i], kept_partner[i], kept_stamp[i] = t_hit, partner, count[partner]
-            else:
-                dt_hit, partner = scan(i, t, exclude, xi, yi, vxi, vyi, ri, zip(blocks[c], shifts[c]))
-                t_hit = t + dt_hit
-                kept_time[i], kept_partner[i] = t_hit, partner
-                if partner >= 0:
-                    kept_stamp[i] = count[partner]
-            schedule(i, t, xi, yi, vxi, vyi, ri, c, t_hit, partner, exclude)
 
         def predictions() -> int:
             return n_pred

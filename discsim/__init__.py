@@ -30,7 +30,7 @@ from discsim.errors import (
 from discsim.event_driven import EventDriven
 from discsim.eventlog import StreamedEvents, read_events, trajectory_from_events
 from discsim.fixed_step import FixedStep
-from discsim.observables import compressibility_factor, enskog_collision_rate, henderson_z
+from discsim.observables import compressibility_factor, enskog_collision_rate, henderson_z, speed_cdf, speed_pdf
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
 from discsim.state import Box, Discs, Segment, polygon
 
@@ -68,6 +68,8 @@ __all__ = [
     "read_events",
     "resume",
     "scenarios",
+    "speed_cdf",
+    "speed_pdf",
     "study_cases",
     "trajectory_from_events",
 ]

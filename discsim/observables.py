@@ -17,6 +17,8 @@ __all__ = [
     "enskog_collision_rate",
     "henderson_z",
     "packing_fraction",
+    "speed_cdf",
+    "speed_pdf",
 ]
 
 
@@ -35,9 +37,35 @@ def henderson_z(packing_fraction):
 
 
 def contact_value(packing_fraction):
-    """Pair distribution at contact ``g(sigma) = (Z - 1) / (2 eta)`` from :func:`henderson_z`."""
+    """Pair distribution at contact ``g(sigma) = (Z - 1) / (2 eta)`` from :func:`henderson_z`.
+
+    In closed form ``g = (1 - 7 eta / 16) / (1 - eta)^2``, which is 1 at ``eta = 0``.
+
+    Example:
+        >>> float(contact_value(0.0)), round(float(contact_value(0.3)), 6)
+        (1.0, 1.772959)
+    """
     eta = np.asarray(packing_fraction, dtype=float)
-    return (henderson_z(eta) - 1.0) / (2.0 * eta)
+    return (1.0 - 7.0 * eta / 16.0) / (1.0 - eta) ** 2
+
+
+def speed_pdf(speed, kT: float = 1.0, mass: float = 1.0):
+    """The 2D Maxwell-Boltzmann (Rayleigh) density of speeds, per unit speed.
+
+    ``p(v) = (m v / kT) exp(-m v^2 / (2 kT))``.
+
+    Example:
+        >>> round(float(speed_pdf(1.0)), 6)
+        0.606531
+    """
+    v = np.asarray(speed, dtype=float)
+    return (mass * v / kT) * np.exp(-mass * v**2 / (2.0 * kT))
+
+
+def speed_cdf(speed, kT: float = 1.0, mass: float = 1.0):
+    """The 2D Maxwell-Boltzmann (Rayleigh) cumulative distribution of speeds, ``1 - exp(-m v^2 / (2 kT))``."""
+    v = np.asarray(speed, dtype=float)
+    return 1.0 - np.exp(-mass * v**2 / (2.0 * kT))
 
 
 def enskog_collision_rate(packing_fraction, radius: float = 1.0, kT: float = 1.0, mass: float = 1.0):

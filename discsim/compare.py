@@ -319,7 +319,7 @@ def _default_window(discs, dt: float) -> float:
     return max(2.0 * dt, sigma_min / v_typical)
 
 
-def compare(truth, approx, *, window: float | None = None, times=None) -> Comparison:
+def compare(truth, approx, *, window: float | None = None, times=None, until: float | None = None) -> Comparison:
     """Compare a run against a reference run from the same start.
 
     Collisions (disc-disc records of the event logs) are matched by unordered
@@ -345,6 +345,11 @@ def compare(truth, approx, *, window: float | None = None, times=None) -> Compar
             Both need ``record=True``, the same discs at the same start time
             and the same box.
         window: matching window in time units (>= 0), overriding the default.
+        until: count the collisions of the truth up to this time only, while
+            the approximation's detections up to ``until + window`` may still
+            match them (a fixed-step run sees a contact just before ``until``
+            only at its next frame: run it a few frames past ``until``).
+            Default: the end of the shorter run.
         times: sample times ``(T,)`` for the position error; default the
             frame times of the engine with the larger ``dt`` over the common
             span, or 201 evenly spaced times when neither has one.
@@ -388,7 +393,11 @@ def compare(truth, approx, *, window: float | None = None, times=None) -> Compar
             )
             raise ValueError(msg)
     start = max(float(truth.start_time), float(approx.start_time))
-    horizon = min(float(truth.time), float(approx.time))
+    common = min(float(truth.time), float(approx.time))
+    horizon = common if until is None else float(until)
+    if not (start <= horizon <= common):
+        msg = f"until={until!r} must lie within the span both runs cover, [{start!r}, {common!r}]"
+        raise ValueError(msg)
     dts = [float(getattr(e, "dt", 0.0) or 0.0) for e in (truth, approx)]
     if window is None:
         window = _default_window(truth.discs, max(dts))
@@ -397,11 +406,13 @@ def compare(truth, approx, *, window: float | None = None, times=None) -> Compar
         raise ValueError(msg)
     window = float(window)
 
-    # Collisions within the common span.
+    # Collisions within the common span (the approximation's up to a window past an explicit until).
     ev_t, ev_a = truth.events, approx.events
+    reach = horizon if until is None else min(common, horizon + window)
     ev_t = ev_t[(ev_t["time"] >= start) & (ev_t["time"] <= horizon)]
-    ev_a = ev_a[(ev_a["time"] >= start) & (ev_a["time"] <= horizon)]
+    ev_a = ev_a[(ev_a["time"] >= start) & (ev_a["time"] <= reach)]
     matched, missed, spurious = _match(_collisions(ev_t), _collisions(ev_a), window)
+    spurious = [(i, j, t) for i, j, t in spurious if t <= horizon]
     delays = np.array([ta - tt for _, (tt, _), (ta, _) in matched])
     directions = np.full((len(matched), 2), np.nan)
     for k, ((i, j), (_, rt), (_, ra)) in enumerate(matched):
@@ -439,9 +450,9 @@ def compare(truth, approx, *, window: float | None = None, times=None) -> Compar
         horizon=horizon,
         window=window,
         truth_collisions=int((ev_t["kind"] == COLLISION).sum()),
-        approx_collisions=int((ev_a["kind"] == COLLISION).sum()),
+        approx_collisions=int(((ev_a["kind"] == COLLISION) & (ev_a["time"] <= horizon)).sum()),
         truth_wall_hits=int((ev_t["kind"] == WALL).sum()),
-        approx_wall_hits=int((ev_a["kind"] == WALL).sum()),
+        approx_wall_hits=int(((ev_a["kind"] == WALL) & (ev_a["time"] <= horizon)).sum()),
         matches=[(i, j, tt, ta) for (i, j), (tt, _), (ta, _) in matched],
         missed_collisions=missed,
         spurious_collisions=spurious,

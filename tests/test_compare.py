@@ -211,3 +211,22 @@ def test_pit_converges_on_a_dilute_gas():
     assert scaled.max() / scaled.min() < 2.0  # error / dt bounded: error proportional to dt
     rms = np.array([r.position_error_rms for r in reports])
     assert rms[-1] < rms[2] / 100
+
+
+def test_until_lets_a_detection_just_past_the_horizon_match():
+    # Two discs meet at t = 0.95; PIT at 10 frames per unit time sees the overlap only at t = 1.0.
+    discs = ds.Discs([[2.0, 5.0], [5.9, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], 1.0)
+    box = ds.Box(20.0, 10.0)
+    pic = ds.EventDriven(discs, box).run(until=1.2)
+    pit = ds.FixedStep(discs, box, frame_rate=10.0).run(until=1.2)
+    assert pic.events["time"][0] == pytest.approx(0.95)
+    clipped = ds.compare(pic, pit, until=0.97, window=0.1)
+    assert (clipped.truth_collisions, clipped.matched, clipped.missed, clipped.spurious) == (1, 1, 0, 0)
+    assert clipped.delays[0] == pytest.approx(0.05)
+    assert clipped.horizon == 0.97
+    # without the grace the same horizon reads as a miss
+    pic_short = ds.EventDriven(discs, box).run(until=0.97)
+    pit_short = ds.FixedStep(discs, box, frame_rate=10.0).run(until=0.97)
+    assert ds.compare(pic_short, pit_short, window=0.1).missed == 1
+    with pytest.raises(ValueError, match="until=5.0 must lie within"):
+        ds.compare(pic, pit, until=5.0)

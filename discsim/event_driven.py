@@ -40,6 +40,8 @@ __all__ = ["EventDriven"]
 INF = math.inf
 # Kinds of queued events. COLLISION and WALL match discsim.eventlog.
 _COLLISION, _WALL, _CROSSING, _SEGMENT = 0, 1, 2, 3
+# Physical events between moves of the internal clock's epoch (at least 16 per disc).
+_REBASE_EVENTS = 1 << 18
 # Directions of a cell crossing.
 _PLUS_X, _MINUS_X, _PLUS_Y, _MINUS_Y = 0, 1, 2, 3
 
@@ -117,6 +119,7 @@ class EventDriven(Engine):
         self._log = EventLog()
         self._virial = 0.0
         self._last = None
+        self._epoch, self._since_rebase = 0.0, 0
         self._counts = {"collisions": 0, "wall_hits": 0, "cell_crossings": 0, "stale": 0}
         self.max_overlap = 0.0
         self._predict, self._predictions = self._make_predictor(0)
@@ -159,6 +162,7 @@ class EventDriven(Engine):
         self._radius = discs.radii.tolist()
         self._mass = discs.masses.tolist()
         self._moving = np.isfinite(discs.masses).tolist()
+        self._rebase_every = max(_REBASE_EVENTS, 16 * n)
 
     # --- saving and restoring ----------------------------------------------------------
     _STATE_FLOATS = ("_rx", "_ry", "_vx", "_vy", "_tr", "_kept_time")
@@ -178,6 +182,8 @@ class EventDriven(Engine):
         state["queue_payload"] = np.array([p for _, _, p in pending], dtype=np.int64).reshape(-1, 3)
         state["scalars"] = {
             "time": self.time,
+            "epoch": self._epoch,
+            "since_rebase": self._since_rebase,
             "virial": self._virial,
             "max_overlap": self.max_overlap,
             "max_queue": self.max_queue,
@@ -227,6 +233,8 @@ class EventDriven(Engine):
         if len(state["events"]):
             sim._log.extend(state["events"])
         sim.time = scalars["time"]
+        sim._epoch = scalars.get("epoch", 0.0)
+        sim._since_rebase = scalars.get("since_rebase", 0)
         sim._virial = scalars["virial"]
         sim.max_overlap = scalars["max_overlap"]
         sim.max_queue = scalars["max_queue"]
@@ -239,7 +247,7 @@ class EventDriven(Engine):
     @property
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
-        t = self.time
+        t = self.time - self._epoch
         rx, ry, tr = np.array(self._rx), np.array(self._ry), np.array(self._tr)
         vx, vy = np.array(self._vx), np.array(self._vy)
         out = np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)])
@@ -817,10 +825,14 @@ class EventDriven(Engine):
         n_coll = n_wall = n_cross = n_stale = 0
         done = 0
         max_queue = self.max_queue
-        now, last, virial = self.time, None, self._virial
+        now, last, virial = None, None, self._virial
         radius, sqrt, max_overlap = self._radius, math.sqrt, self.max_overlap
+        # Internal times run from the epoch, which moves every REBASE_EVERY physical events.
+        epoch = self._epoch
+        horizon = until - epoch
+        rebase_at = self._rebase_every - self._since_rebase
         while done != limit:
-            popped = pop_before(until)
+            popped = pop_before(horizon)
             if popped is None:
                 break
             t, i, (kind, other, stamp) = popped
@@ -855,12 +867,12 @@ class EventDriven(Engine):
                 n_coll += 1
                 done += 1
                 if log is not None:
-                    log.collision(t, i, j, xi, yi, uxi, uyi, xj, yj, uxj, uyj)
+                    log.collision(t + epoch, i, j, xi, yi, uxi, uyi, xj, yj, uxj, uyj)
                 predict(i, t, j)
                 if moving[j]:
                     count[j] += 1
                     predict(j, t, i)
-                last = (t, _COLLISION, i, j)
+                last = (t + epoch, _COLLISION, i, j)
             elif kind == _WALL:
                 dt = t - tr[i]
                 xi = rx[i] = rx[i] + vx[i] * dt
@@ -874,9 +886,9 @@ class EventDriven(Engine):
                 n_wall += 1
                 done += 1
                 if log is not None:
-                    log.wall(t, i, xi, yi, vx[i], vy[i])
+                    log.wall(t + epoch, i, xi, yi, vx[i], vy[i])
                 predict(i, t, -1)
-                last = (t, _WALL, i, -1)
+                last = (t + epoch, _WALL, i, -1)
             elif kind == _SEGMENT:
                 dt = t - tr[i]
                 xi = rx[i] = rx[i] + vx[i] * dt
@@ -887,9 +899,9 @@ class EventDriven(Engine):
                 n_wall += 1
                 done += 1
                 if log is not None:
-                    log.wall(t, i, xi, yi, vx[i], vy[i])
+                    log.wall(t + epoch, i, xi, yi, vx[i], vy[i])
                 predict(i, t, -2 - other)  # never the same segment again straight away
-                last = (t, _WALL, i, -1)
+                last = (t + epoch, _WALL, i, -1)
             else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
                 c = cell[i]
                 cells[c].remove(i)
@@ -923,8 +935,16 @@ class EventDriven(Engine):
             size = len(queue)
             if size > max_queue:
                 max_queue = size
+            if done >= rebase_at:
+                self._rebase(now)
+                epoch, now = self._epoch, 0.0
+                horizon = until - epoch
+                rebase_at = done + self._rebase_every
+        self._since_rebase = self._rebase_every - (rebase_at - done)
         self.max_queue = max_queue
-        self.time, self._virial, self.max_overlap = now, virial, max_overlap
+        self._virial, self.max_overlap = virial, max_overlap
+        if now is not None:
+            self.time = now + epoch
         if last is not None:
             self._last = last
         counts["collisions"] += n_coll
@@ -932,6 +952,20 @@ class EventDriven(Engine):
         counts["cell_crossings"] += n_cross
         counts["stale"] += n_stale
         return done
+
+    def _rebase(self, shift: float) -> None:
+        """Move the epoch of the internal clock forward by ``shift`` (the current internal time).
+
+        Positions are ``r + v (t - t_ref)`` with times measured from the epoch;
+        keeping those times small keeps their resolution, and so the contact
+        geometry, at the roundoff of the first steps of the run however long
+        it goes on. O(N log N); the hot loop calls it every ``_rebase_every``
+        physical events, a count that does not depend on how a run is split.
+        """
+        self._tr[:] = [t - shift for t in self._tr]
+        self._kept_time[:] = [t - shift for t in self._kept_time]
+        self._queue.shift_times(shift)
+        self._epoch += shift
 
     # --- invariants ------------------------------------------------------------------
     def _check(self) -> None:
@@ -959,7 +993,7 @@ class EventDriven(Engine):
                 )
                 assert inside_x and inside_y, f"disc {i} at {pos[i]} is not in its cell {c}"
             t_pending, payload = self._queue.pending(i)
-            assert t_pending >= self.time - 1e-12 * max(1.0, self.time)
+            assert t_pending >= self.time - self._epoch - 1e-12 * max(1.0, self.time)
             if self._moving[i] and (self._vx[i] or self._vy[i]):
                 assert payload is not None or t_pending == INF
         check_fits(Discs(pos, self.velocities, self.discs.radii, self.discs.masses), self.box)

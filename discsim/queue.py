@@ -50,6 +50,12 @@ class EventQueue:
         self._time[owner] = time
         self._payload[owner] = payload
 
+    def shift_times(self, delta: float) -> None:
+        """Subtract ``delta`` from every pending time (a new time origin). O(n log n)."""
+        self._time = [t - delta for t in self._time]
+        self._keys.clear()
+        self._keys.update((t, o) for o, t in enumerate(self._time) if t != math.inf)
+
     def pop_before(self, until: float):
         """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
         keys = self._keys
@@ -132,6 +138,11 @@ class HeapEventQueue:
             heapq.heappush(self._heap, (time, owner, version))
             if len(self._heap) > 2 * self._live + 16:
                 self._compact()
+
+    def shift_times(self, delta: float) -> None:
+        """Subtract ``delta`` from every pending time (a new time origin). O(n)."""
+        self._time = [t - delta for t in self._time]
+        self._compact()
 
     def _compact(self) -> None:
         self._heap = [(t, o, self._version[o]) for o, t in enumerate(self._time) if t != math.inf]

@@ -26,13 +26,29 @@ Definitions, as printed and written to CSV:
   own peak resident size is printed at the end; it is larger, because memory
   freed by one run is not returned to the system before the next.
 
-Sections are functions listed in :data:`SECTIONS`; the fixed-step (PIT)
-sections of issue 4 join that list when the PIT engine lands. Output:
-``throughput.csv``, ``throughput_queue.csv`` and ``throughput.png`` in ``--results``.
+PIT (fixed-step) sections, on the same kind of equilibrated periodic gas:
+
+* ``frames/s`` and ``tests/s``: :class:`discsim.FixedStep` frames and
+  narrow-phase pair tests (``counts["pair_tests"]``) per wall-clock second,
+  with the cell grid and with all pairs (all pairs only up to
+  ``pit_all_pairs_max`` discs), at packing fraction 0.3 and the frame step that
+  keeps PIT within 1% missed collisions there.
+* ``PIC s/unit t`` and ``PIT s/unit t``: wall-clock seconds per unit of
+  simulated time of the event-driven engine, and of the fixed-step engine
+  (cell grid, policy ``resolve``) at that 1% frame step, timed side by side from
+  the same gases. The step ``s = v dt / r`` (``v`` the rms speed) is read from
+  ``accuracy_map_boundary.csv`` (column ``largest_step_missed_ok``), or measured
+  with :func:`discsim.compare` when that file is missing; the output says
+  which. ``crossover step``: the step at which PIT would cost as much as PIC.
+
+Sections are functions listed in :data:`SECTIONS`. Output: ``throughput.csv``,
+``throughput_queue.csv``, ``throughput_pit.csv``, ``throughput_crossover.csv``,
+``throughput.png`` and ``throughput_pit.png`` in ``--results``.
 """
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import gc
 import math
@@ -42,6 +58,7 @@ import tracemalloc
 from pathlib import Path
 
 from benchutils import (
+    DEFAULT_RESULTS,
     Column,
     announce,
     format_table,
@@ -69,6 +86,12 @@ class Config:
         timed_per_disc, timed_min: the timed segment has
             ``max(timed_per_disc * N, timed_min)`` collisions.
         queue_sizes, queue_fraction: where ``sorted`` and ``heap`` queues run side by side.
+        pit_sizes: N of the fixed-step frames/s section (packing fraction 0.3).
+        pit_all_pairs_max: largest N at which the all-pairs broad phase runs.
+        pit_frames, pit_all_pairs_frames: timed frames per run in that section
+            (cell grid, all pairs: an all-pairs frame at N = 10^4 takes seconds).
+        cost_sizes, cost_fractions: where PIC and PIT cost per unit of simulated time are compared.
+        cost_frames: timed PIT frames per run in that comparison.
         memory: run the tracemalloc pass.
     """
 
@@ -80,6 +103,13 @@ class Config:
     timed_min: int
     queue_sizes: tuple[int, ...]
     queue_fraction: float
+    pit_sizes: tuple[int, ...] = ()
+    pit_all_pairs_max: int = 0
+    pit_frames: int = 20
+    pit_all_pairs_frames: int = 3
+    cost_sizes: tuple[int, ...] = ()
+    cost_fractions: tuple[float, ...] = ()
+    cost_frames: int = 50
     memory: bool = True
 
     def timed_collisions(self, n: int) -> int:
@@ -96,6 +126,12 @@ FULL = Config(
     timed_min=50_000,
     queue_sizes=(1_000, 10_000, 100_000),
     queue_fraction=0.3,
+    pit_sizes=(1_000, 10_000, 100_000),
+    pit_all_pairs_max=10_000,
+    pit_frames=20,
+    cost_sizes=(1_000, 10_000),
+    cost_fractions=(0.3, 0.6),
+    cost_frames=100,
 )
 
 QUICK = Config(
@@ -107,6 +143,12 @@ QUICK = Config(
     timed_min=1_000,
     queue_sizes=(400,),
     queue_fraction=0.3,
+    pit_sizes=(100, 400),
+    pit_all_pairs_max=400,
+    pit_frames=5,
+    cost_sizes=(100,),
+    cost_fractions=(0.3,),
+    cost_frames=20,
 )
 
 _EVENT_KINDS = ("collisions", "wall_hits", "cell_crossings", "stale")
@@ -311,6 +353,267 @@ def queue_section(config: Config, results: Path) -> list[dict]:
     return rows
 
 
+# --- fixed step (PIT) ------------------------------------------------------------------
+#: Packing fraction of the PIT frames/s section (issue 3's speed target is set there).
+PIT_FRACTION = 0.3
+#: PIT response policy whose 1%-missed frame step is used for the cost comparison.
+COST_POLICY = "resolve"
+#: Steps ``s = v dt / r`` tried when the accuracy map's boundary file is missing.
+_FALLBACK_STEPS = (0.001, 0.00215, 0.00464, 0.01, 0.0215, 0.0464, 0.1)
+
+
+def _equilibrated(n: int, packing_fraction: float, seed: int, per_disc: float) -> tuple[ds.Discs, ds.Box]:
+    """A periodic random gas run under PIC for ``per_disc`` collisions per disc, as new discs and its box."""
+    discs, box = ds.random_gas(n, packing_fraction, periodic=True, seed=seed)
+    sim = ds.EventDriven(discs, box, record=False)
+    sim.run(events=max(1, round(per_disc * n)))
+    return ds.Discs(sim.positions, sim.velocities, discs.radii, discs.masses), box
+
+
+def _rms_speed(discs: ds.Discs) -> float:
+    return math.sqrt(float((discs.velocities**2).sum(axis=1).mean()))
+
+
+def measure_pit(discs: ds.Discs, box: ds.Box, dt: float, broad_phase: str, frames: int) -> dict:
+    """Time ``frames`` frames of :class:`discsim.FixedStep` (policy ``resolve``) after one untimed frame.
+
+    Returns:
+        ``seconds`` and ``cpu_seconds`` of the timed frames, and the ``frames``,
+        ``pair_tests`` and ``detections`` counted in them.
+    """
+    gc.collect()
+    sim = ds.FixedStep(discs, box, dt=dt, policy=COST_POLICY, broad_phase=broad_phase, record=False)
+    sim.run(frames=1)  # first frame builds the grid: not what a long run pays per frame
+    before = dict(sim.counts)
+    run = timed(lambda: sim.run(frames=frames))
+    delta = {k: sim.counts[k] - before[k] for k in ("frames", "pair_tests", "detections")}
+    return {"seconds": run.wall, "cpu_seconds": run.cpu, **delta}
+
+
+def _pit_row(runs: list[dict], n: int, packing_fraction: float, broad_phase: str, dt: float) -> dict:
+    """One table row from repeated PIT runs (medians)."""
+    return {
+        "n": n,
+        "packing_fraction": packing_fraction,
+        "broad_phase": broad_phase,
+        "repeats": len(runs),
+        "dt": dt,
+        "timed_frames": runs[0]["frames"],
+        "frames_per_s": median([r["frames"] / r["seconds"] for r in runs]),
+        "frames_per_cpu_s": median([r["frames"] / r["cpu_seconds"] for r in runs]),
+        "seconds_per_frame": median([r["seconds"] / r["frames"] for r in runs]),
+        "pair_tests_per_frame": median([r["pair_tests"] / r["frames"] for r in runs]),
+        "pair_tests_per_s": median([r["pair_tests"] / r["seconds"] for r in runs]),
+        "detections_per_frame": median([r["detections"] / r["frames"] for r in runs]),
+    }
+
+
+PIT_COLUMNS = [
+    Column("n", "N", ","),
+    Column("broad_phase", "broad phase"),
+    Column("frames_per_s", "frames/s", ",.1f"),
+    Column("frames_per_cpu_s", "frames/CPU-s", ",.1f"),
+    Column("seconds_per_frame", "s/frame", ".3g"),
+    Column("pair_tests_per_frame", "tests/frame", ",.0f"),
+    Column("pair_tests_per_s", "tests/s", ",.3g"),
+    Column("detections_per_frame", "det/frame", ".1f"),
+    Column("timed_frames", "frames", ","),
+]
+
+
+def pit_throughput_section(config: Config, results: Path) -> list[dict]:
+    """FixedStep frames/s and pair tests/s against N, cell grid against all pairs (periodic gas, phi 0.3).
+
+    The frame step is the one that keeps PIT within 1% missed collisions at
+    this packing fraction (see :func:`one_percent_step`).
+    """
+    phi = PIT_FRACTION
+    step, source = one_percent_step(phi, results)
+    print(f"periodic gas, phi={phi}, policy {COST_POLICY}; frame step v dt / r = {step:.3g} ({source})")
+    rows = []
+    for n in config.pit_sizes:
+        phases = ["grid"] + (["all-pairs"] if n <= config.pit_all_pairs_max else [])
+        runs = {bp: [] for bp in phases}
+        for seed in range(config.repeats):
+            discs, box = _equilibrated(n, phi, seed, config.equilibrate_per_disc)
+            dt = step * float(discs.radii.mean()) / _rms_speed(discs)
+            for bp in phases:  # interleaved, so that drift in the machine's load hits both
+                frames = config.pit_frames if bp == "grid" else config.pit_all_pairs_frames
+                announce(f"  PIT N={n:,} {bp}: run {seed + 1}/{config.repeats}, {frames} frames")
+                runs[bp].append(measure_pit(discs, box, dt, bp, frames))
+        rows += [_pit_row(runs[bp], n, phi, bp, dt) for bp in phases]
+    print(format_table(rows, PIT_COLUMNS))
+    keys = [c.key for c in PIT_COLUMNS] + ["packing_fraction", "dt", "repeats"]
+    write_csv(results / "throughput_pit.csv", rows, keys)
+    return rows
+
+
+def one_percent_step(packing_fraction: float, results: Path) -> tuple[float, str]:
+    """The largest frame step ``s = v dt / r`` at which PIT (policy ``resolve``) misses at most 1% of collisions.
+
+    Read from ``accuracy_map_boundary.csv`` (``largest_step_missed_ok``, the
+    nearest packing fraction on the map) in ``results`` or the default results
+    folder; when neither has it, measured here with :func:`discsim.compare`
+    (:func:`measure_one_percent_step`).
+
+    Returns:
+        The step and a few words saying where it came from.
+    """
+    for folder in dict.fromkeys((results, DEFAULT_RESULTS)):
+        path = folder / "accuracy_map_boundary.csv"
+        if not path.exists():
+            continue
+        with open(path, newline="") as handle:
+            rows = [r for r in csv.DictReader(handle) if r["policy"] == COST_POLICY]
+        rows = [r for r in rows if not math.isnan(float(r["largest_step_missed_ok"]))]
+        if rows:
+            row = min(rows, key=lambda r: abs(float(r["packing_fraction"]) - packing_fraction))
+            phi = float(row["packing_fraction"])
+            return float(row["largest_step_missed_ok"]), f"accuracy_map_boundary.csv at phi={phi:g}"
+    return measure_one_percent_step(packing_fraction), "measured with ds.compare, N=200, 2 mean free times"
+
+
+def measure_one_percent_step(packing_fraction: float, n: int = 200) -> float:
+    """The largest of :data:`_FALLBACK_STEPS` at which PIT misses at most 1% of PIC's collisions.
+
+    One equilibrated periodic gas, two mean free times, PIC and PIT from the
+    same start, judged by :func:`discsim.compare`. Returns the smallest step
+    tried if none is good.
+    """
+    discs, box = _equilibrated(n, packing_fraction, 0, 5.0)
+    horizon = 2.0 / float(ds.enskog_collision_rate(packing_fraction))
+    scale = float(discs.radii.mean()) / _rms_speed(discs)
+    truth = ds.EventDriven(discs, box).run(until=2.0 * horizon)
+    good = _FALLBACK_STEPS[0]
+    for step in _FALLBACK_STEPS:
+        approx = ds.FixedStep(discs, box, dt=step * scale, policy=COST_POLICY).run(until=horizon + step * scale)
+        if ds.compare(truth, approx, until=horizon).missed_fraction > 0.01:
+            break
+        good = step
+    return good
+
+
+def measure_pic_cost(discs: ds.Discs, box: ds.Box, collisions: int) -> dict:
+    """Wall and CPU seconds of PIC per unit of simulated time over about ``collisions`` collisions."""
+    gc.collect()
+    sim = ds.EventDriven(discs, box, record=False)
+    run = timed(lambda: sim.run(events=collisions))
+    return {
+        "seconds": run.wall / sim.time,
+        "cpu_seconds": run.cpu / sim.time,
+        "collisions_per_time": sim.counts["collisions"] / sim.time,
+    }
+
+
+COST_COLUMNS = [
+    Column("n", "N", ","),
+    Column("packing_fraction", "phi", ".2f"),
+    Column("step", "step 1%", ".3g"),
+    Column("frame_rate", "frames/unit t", ",.0f"),
+    Column("pic_s_per_time", "PIC s/unit t", ".3g"),
+    Column("pit_s_per_time", "PIT s/unit t", ".3g"),
+    Column("pit_over_pic", "PIT/PIC", ".2f"),
+    Column("pit_over_pic_cpu", "PIT/PIC (CPU)", ".2f"),
+    Column("crossover_step", "crossover step", ".3g"),
+    Column("pic_collisions_per_time", "PIC coll/unit t", ",.0f"),
+]
+
+
+def pic_against_pit_section(config: Config, results: Path) -> list[dict]:
+    """Seconds of wall time per unit of simulated time: PIC, and PIT at the frame step for 1% missed.
+
+    ``crossover step`` is the frame step ``s = v dt / r`` at which PIT would cost
+    as much as PIC (its seconds per frame times ``v / (s r)`` frames per unit
+    time); PIT at 1% missed is cheaper than PIC only where ``step 1%`` exceeds it.
+    """
+    rows = []
+    for phi in config.cost_fractions:
+        step, source = one_percent_step(phi, results)
+        print(f"phi={phi}: frame step for 1% missed v dt / r = {step:.3g} ({source})")
+        for n in config.cost_sizes:
+            rows.append(_cost_point(n, phi, step, config))
+    print(format_table(rows, COST_COLUMNS))
+    print(_crossover_summary(rows))
+    write_csv(results / "throughput_crossover.csv", rows, [c.key for c in COST_COLUMNS] + ["dt", "repeats"])
+    return rows
+
+
+def _cost_point(n: int, phi: float, step: float, config: Config) -> dict:
+    """PIC and PIT, interleaved over the repeats, from the same equilibrated gases."""
+    pic, pit = [], []
+    for seed in range(config.repeats):
+        announce(f"  cost N={n:,} phi={phi}: run {seed + 1}/{config.repeats}")
+        discs, box = _equilibrated(n, phi, seed, config.equilibrate_per_disc)
+        dt = step * float(discs.radii.mean()) / _rms_speed(discs)
+        pic.append(measure_pic_cost(discs, box, config.timed_collisions(n)))
+        pit.append(measure_pit(discs, box, dt, "grid", config.cost_frames))
+    frame = median([r["seconds"] / r["frames"] for r in pit])
+    frame_cpu = median([r["cpu_seconds"] / r["frames"] for r in pit])
+    pic_s = median([r["seconds"] for r in pic])
+    pic_cpu = median([r["cpu_seconds"] for r in pic])
+    speed_over_radius = step / dt  # v / r
+    return {
+        "n": n,
+        "packing_fraction": phi,
+        "step": step,
+        "dt": dt,
+        "repeats": config.repeats,
+        "frame_rate": 1.0 / dt,
+        "pic_s_per_time": pic_s,
+        "pit_s_per_time": frame / dt,
+        "pit_over_pic": frame / dt / pic_s,
+        "pit_over_pic_cpu": frame_cpu / dt / pic_cpu,
+        "crossover_step": frame * speed_over_radius / pic_s,
+        "pic_collisions_per_time": median([r["collisions_per_time"] for r in pic]),
+    }
+
+
+def _crossover_summary(rows: list[dict]) -> str:
+    """One line per row: is PIT at 1% missed cheaper than PIC, and by how much the step would have to grow."""
+    lines = []
+    for r in rows:
+        factor = r["crossover_step"] / r["step"]
+        verdict = "PIT cheaper" if factor < 1 else f"PIC cheaper; PIT would need a {factor:.3g}x larger step"
+        lines.append(f"N={r['n']:,} phi={r['packing_fraction']:g}: PIT/PIC = {r['pit_over_pic']:.3g} ({verdict})")
+    return "\n".join(lines)
+
+
+def plot_pit(pit_rows: list[dict], cost_rows: list[dict], path: Path) -> Path:
+    """Two panels: PIT frames/s against N (grid, all pairs), and PIC and PIT seconds per unit simulated time."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_frames, ax_cost) = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
+    for bp, marker in (("grid", "o"), ("all-pairs", "s")):
+        rows = [r for r in pit_rows if r["broad_phase"] == bp]
+        if rows:
+            ax_frames.plot([r["n"] for r in rows], [r["frames_per_s"] for r in rows], marker=marker, label=bp)
+    ax_frames.set(xscale="log", yscale="log", xlabel="N discs", ylabel="frames / s (median)")
+    ax_frames.set_title(f"discsim FixedStep, phi={PIT_FRACTION:g}")
+    for phi in sorted({r["packing_fraction"] for r in cost_rows}):
+        rows = [r for r in cost_rows if r["packing_fraction"] == phi]
+        ns = [r["n"] for r in rows]
+        (line,) = ax_cost.plot(ns, [r["pic_s_per_time"] for r in rows], marker="o", label=f"PIC, phi={phi:g}")
+        ax_cost.plot(
+            ns,
+            [r["pit_s_per_time"] for r in rows],
+            "--",
+            marker="s",
+            color=line.get_color(),
+            label=f"PIT 1%, phi={phi:g}",
+        )
+    ax_cost.set(xscale="log", yscale="log", xlabel="N discs", ylabel="wall s per unit simulated time")
+    ax_cost.set_title("PIC against PIT at 1% missed")
+    for ax in (ax_frames, ax_cost):
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def plot(throughput_rows: list[dict], queue_rows: list[dict], path: Path) -> Path:
     """Two panels: collisions/s against N (each phi; heap queue dashed), and max queue size against N."""
     import matplotlib
@@ -355,12 +658,11 @@ def plot(throughput_rows: list[dict], queue_rows: list[dict], path: Path) -> Pat
 
 
 #: The sections in run order: (title, function(config, results) -> rows).
-#: The PIT sections of issue 4 (frames/s and pair tests/s against N, cell grid
-#: against all pairs, PIC against PIT cost per unit of simulated time) are added
-#: to this list by the fixed-step work.
 SECTIONS = [
     ("PIC throughput (periodic random gas, sorted queue)", pic_throughput_section),
     ("PIC event queue: sorted against heap", queue_section),
+    ("PIT throughput: frames/s and pair tests/s, cell grid against all pairs", pit_throughput_section),
+    ("PIC against PIT: seconds per unit simulated time at 1% missed", pic_against_pit_section),
 ]
 
 
@@ -377,9 +679,13 @@ def main(argv=None) -> int:
         print(f"\n== {title} ==")
         outputs[section.__name__] = section(config, args.results)
     png = plot(outputs["pic_throughput_section"], outputs["queue_section"], args.results / "throughput.png")
+    pit_png = plot_pit(
+        outputs["pit_throughput_section"], outputs["pic_against_pit_section"], args.results / "throughput_pit.png"
+    )
     print(f"\nthis script's peak resident memory: {peak_resident_mb():.0f} MB")
     print(f"load average at the end: {load_average():.2f}")
-    print(f"wrote {args.results / 'throughput.csv'}, {args.results / 'throughput_queue.csv'}, {png}")
+    written = ["throughput.csv", "throughput_queue.csv", "throughput_pit.csv", "throughput_crossover.csv"]
+    print(f"wrote {', '.join(str(args.results / f) for f in written)}, {png}, {pit_png}")
     return 0
 
 

@@ -25,9 +25,28 @@ counts then agree statistically, not exactly.
 A peer that has not finished within the budget (setup plus run: 60 s, 30 s
 with ``--quick``) is stopped, the point is reported as such, and larger N are skipped for it.
 
-Sections are functions listed in :data:`SECTIONS`; the PIT-against-pymunk
-section of issue 4 joins that list when the fixed-step engine lands.
-Output: ``peers.csv`` and ``peers.png`` in ``--results``.
+PIT section: discsim's :class:`~discsim.FixedStep` (cell grid, policy
+``resolve``) against ``pymunk`` (PyPI, optional; circles of elasticity 1 and
+friction 0, four static segments for the walls, no gravity, pymunk's default
+space otherwise: 10 iterations, ``collision_slop`` 0.1, bounding-box tree).
+Both start from the same walled gas (the seeded random gas above, melted by
+PIC for one collision per disc so that discs touch while timed) and step at the
+same ``dt``: the frame step at which FixedStep misses at most 1% of collisions
+(``accuracy_map_boundary.csv``, or measured; see ``throughput.py``). Reported:
+
+* ``s/frame``: median of ``repeats`` timings of ``pit_frames`` frames (no
+  callbacks installed), and each engine's ratio to pymunk;
+* over ``T`` (a couple of mean free times), against PIC from the same start:
+  FixedStep through :func:`discsim.compare`; pymunk through a collision handler
+  whose ``begin`` callback records each disc pair that starts touching, with
+  the step's time, matched to PIC's collisions by pair, nearest times first,
+  within the window ``compare`` used (a pair in lasting contact counts once);
+* ``dE/E``: relative change of the kinetic energy over ``T``; ``overlap``:
+  deepest disc-disc overlap as a fraction of the contact distance (pymunk's
+  from ``pre_solve``, before it solves the contact).
+
+Sections are functions listed in :data:`SECTIONS`. Output: ``peers.csv``,
+``peers_pit.csv`` and ``peers.png`` in ``--results``.
 """
 
 from __future__ import annotations
@@ -71,6 +90,10 @@ class Config:
         budget_s: wall-clock seconds one run of one peer may take.
         chunks: the run to ``T`` is done in this many equal steps of time
             (so that a stopped run still reports how far it got).
+        pit_sizes: N at which FixedStep and pymunk frames are timed.
+        pit_frames: frames per timing (median of ``repeats`` timings).
+        pit_accuracy_sizes: N at which both are judged against PIC.
+        pit_horizon_free_times: the accuracy horizon, in mean free times.
     """
 
     sizes: tuple[int, ...]
@@ -80,6 +103,10 @@ class Config:
     repeats: int
     budget_s: float
     chunks: int = 20
+    pit_sizes: tuple[int, ...] = ()
+    pit_frames: int = 20
+    pit_accuracy_sizes: tuple[int, ...] = ()
+    pit_horizon_free_times: float = 2.0
 
     def horizon(self, n: int) -> float:
         """Simulated time ``T`` for ``n`` discs."""
@@ -95,6 +122,9 @@ FULL = Config(
     min_collisions=2_000,
     repeats=3,
     budget_s=60.0,
+    pit_sizes=(1_000, 10_000),
+    pit_frames=20,
+    pit_accuracy_sizes=(1_000, 10_000),
 )
 
 QUICK = Config(
@@ -104,6 +134,10 @@ QUICK = Config(
     min_collisions=100,
     repeats=1,
     budget_s=30.0,
+    pit_sizes=(60,),
+    pit_frames=5,
+    pit_accuracy_sizes=(60,),
+    pit_horizon_free_times=1.0,
 )
 
 
@@ -345,6 +379,260 @@ def pic_peers_section(config: Config, results: Path) -> list[dict]:
     return rows
 
 
+# --- PIT against pymunk ----------------------------------------------------------------
+#: FixedStep's response policy in this section.
+PIT_POLICY = "resolve"
+
+
+def _pymunk():
+    """The ``pymunk`` module, or None when it is not installed."""
+    try:
+        import pymunk
+    except ImportError:
+        return None
+    return pymunk
+
+
+@dataclasses.dataclass
+class PymunkRun:
+    """A pymunk space holding the discs, and what its collision handler saw.
+
+    Attributes:
+        space: the ``pymunk.Space``.
+        bodies: the discs' bodies, in disc order.
+        index: shape -> disc index (walls absent).
+        contacts: ``(i, j, t)`` for each disc pair that began touching (``i < j``),
+            ``t`` the time at the end of that step.
+        wall_contacts: disc-wall contacts begun.
+        deepest: deepest disc-disc overlap seen before a solve, as a fraction of the contact distance.
+        time: simulated time.
+    """
+
+    space: object
+    bodies: list
+    index: dict
+    contacts: list = dataclasses.field(default_factory=list)
+    wall_contacts: int = 0
+    deepest: float = 0.0
+    time: float = 0.0
+
+    def step(self, dt: float, frames: int) -> None:
+        """Advance ``frames`` steps of ``dt``."""
+        space = self.space
+        for _ in range(frames):
+            self.time += dt  # before the step: the callbacks read it as the frame's time
+            space.step(dt)
+
+    def kinetic_energy(self) -> float:
+        """Translational kinetic energy of the discs (friction 0: no rotation is excited)."""
+        return sum(0.5 * b.mass * (b.velocity.x**2 + b.velocity.y**2) for b in self.bodies)
+
+
+def build_pymunk(pymunk, discs: ds.Discs, box: ds.Box, *, watch: bool = False) -> PymunkRun:
+    """The discs as pymunk circles (elasticity 1, friction 0) in four static wall segments, no gravity.
+
+    Args:
+        pymunk: the module.
+        discs, box: a walled discsim configuration.
+        watch: install collision callbacks that record contacts and overlaps
+            (they cost Python calls, so timings run without them).
+    """
+    space = pymunk.Space()
+    space.gravity = (0.0, 0.0)
+    bodies, index = [], {}
+    rows = zip(
+        discs.positions.tolist(), discs.velocities.tolist(), discs.radii.tolist(), discs.masses.tolist(), strict=True
+    )
+    for k, (position, velocity, radius, mass) in enumerate(rows):
+        body = pymunk.Body(mass, pymunk.moment_for_circle(mass, 0.0, radius))
+        body.position, body.velocity = position, velocity
+        shape = pymunk.Circle(body, radius)
+        shape.elasticity, shape.friction = 1.0, 0.0
+        space.add(body, shape)
+        bodies.append(body)
+        index[shape] = k
+    corners = [(0.0, 0.0), (box.width, 0.0), (box.width, box.height), (0.0, box.height)]
+    for k in range(4):
+        wall = pymunk.Segment(space.static_body, corners[k], corners[(k + 1) % 4], 0.0)
+        wall.elasticity, wall.friction = 1.0, 0.0
+        space.add(wall)
+    run = PymunkRun(space, bodies, index)
+    if watch:
+        space.on_collision(begin=_begin, pre_solve=_pre_solve, data=run)
+    return run
+
+
+def _begin(arbiter, space, run: PymunkRun) -> None:
+    first, second = (run.index.get(shape) for shape in arbiter.shapes)
+    if first is None or second is None:
+        run.wall_contacts += 1
+    else:
+        run.contacts.append((min(first, second), max(first, second), run.time))
+
+
+def _pre_solve(arbiter, space, run: PymunkRun) -> None:
+    a, b = arbiter.shapes
+    if a in run.index and b in run.index:
+        depth = max((-p.distance for p in arbiter.contact_point_set.points), default=0.0)
+        run.deepest = max(run.deepest, depth / (a.radius + b.radius))
+
+
+def match_contacts(truth: list, contacts: list, window: float) -> tuple[int, int, int]:
+    """Match contacts to true collisions by pair, nearest times first, within ``window``.
+
+    Args:
+        truth, contacts: ``(i, j, t)`` with ``i < j``.
+
+    Returns:
+        ``(matched, missed, spurious)`` counts.
+    """
+    by_pair: dict = {}
+    for k, (i, j, t) in enumerate(truth):
+        by_pair.setdefault((i, j), ([], []))[0].append((t, k))
+    for k, (i, j, t) in enumerate(contacts):
+        by_pair.setdefault((i, j), ([], []))[1].append((t, k))
+    matched = 0
+    for true_times, found_times in by_pair.values():
+        candidates = sorted((abs(a - b), k, m) for a, k in true_times for b, m in found_times if abs(a - b) <= window)
+        used_true, used_found = set(), set()
+        for _, k, m in candidates:
+            if k not in used_true and m not in used_found:
+                used_true.add(k)
+                used_found.add(m)
+        matched += len(used_true)
+    return matched, len(truth) - matched, len(contacts) - matched
+
+
+def _walled_gas(n: int, config: Config, seed: int = 0) -> tuple[ds.Discs, ds.Box]:
+    """The walled random gas of :func:`compare_engines`, run under PIC for one collision per disc (melted)."""
+    discs, box = ds.random_gas(n, config.packing_fraction, periodic=False, seed=seed)
+    sim = ds.EventDriven(discs, box, record=False)
+    sim.run(events=n)
+    return ds.Discs(sim.positions, sim.velocities, discs.radii, discs.masses), box
+
+
+def frame_step(discs: ds.Discs, config: Config) -> tuple[float, str]:
+    """``dt`` of both engines: the step at which FixedStep misses at most 1% (from the throughput script)."""
+    from benchutils import DEFAULT_RESULTS
+    from throughput import one_percent_step
+
+    step, source = one_percent_step(config.packing_fraction, DEFAULT_RESULTS)
+    speed = math.sqrt(float((discs.velocities**2).sum(axis=1).mean()))
+    return step * float(discs.radii.mean()) / speed, f"v dt / r = {step:.3g}, {source}"
+
+
+def time_frames(pymunk, discs: ds.Discs, box: ds.Box, dt: float, config: Config) -> dict:
+    """Seconds per frame of FixedStep (cell grid) and pymunk: median of ``repeats`` timings, interleaved."""
+    fixed, other = [], []
+    for _ in range(config.repeats):
+        gc.collect()
+        sim = ds.FixedStep(discs, box, dt=dt, policy=PIT_POLICY, record=False)
+        sim.run(frames=1)
+        start = time.perf_counter()
+        sim.run(frames=config.pit_frames)
+        fixed.append((time.perf_counter() - start) / config.pit_frames)
+        if pymunk is not None:
+            gc.collect()
+            run = build_pymunk(pymunk, discs, box)
+            run.step(dt, 1)
+            start = time.perf_counter()
+            run.step(dt, config.pit_frames)
+            other.append((time.perf_counter() - start) / config.pit_frames)
+    return {"fixed_step": median(fixed), "pymunk": median(other)}
+
+
+def judge(pymunk, discs: ds.Discs, box: ds.Box, dt: float, horizon: float) -> dict:
+    """FixedStep and pymunk against PIC over ``[0, horizon]``: missed, spurious, energy drift, deepest overlap."""
+    truth = ds.EventDriven(discs, box).run(until=horizon + 4 * dt)
+    frames = math.ceil(horizon / dt) + 1
+    fixed = ds.FixedStep(discs, box, dt=dt, policy=PIT_POLICY).run(frames=frames)
+    report = ds.compare(truth, fixed, until=horizon)
+    out = {
+        "fixed_step": {
+            "truth": report.truth_collisions,
+            "found": report.approx_collisions,
+            "matched": report.matched,
+            "missed": report.missed,
+            "spurious": report.spurious,
+            "energy_drift": report.approx_energy_change,
+            "overlap": report.max_overlap,
+        }
+    }
+    if pymunk is None:
+        return out
+    events = truth.events
+    rows = (events["j"] >= 0) & (events["time"] <= horizon)
+    true_pairs = [
+        (min(i, j), max(i, j), t)
+        for i, j, t in zip(events["i"][rows].tolist(), events["j"][rows].tolist(), events["time"][rows].tolist())
+    ]
+    run = build_pymunk(pymunk, discs, box, watch=True)
+    energy = run.kinetic_energy()
+    run.step(dt, frames)
+    found = [c for c in run.contacts if c[2] <= horizon + dt]
+    matched, missed, spurious = match_contacts(true_pairs, found, report.window)
+    out["pymunk"] = {
+        "truth": len(true_pairs),
+        "found": len(found),
+        "matched": matched,
+        "missed": missed,
+        "spurious": spurious,
+        "energy_drift": (run.kinetic_energy() - energy) / energy,
+        "overlap": run.deepest,
+    }
+    return out
+
+
+PIT_COLUMNS = [
+    Column("n", "N", ","),
+    Column("engine", "engine"),
+    Column("dt", "dt", ".3g"),
+    Column("seconds_per_frame", "s/frame", ".3g"),
+    Column("pymunk_ratio", "/ pymunk", ".2f"),
+    Column("horizon", "T", ".3g"),
+    Column("truth", "PIC coll", ","),
+    Column("found", "found", ","),
+    Column("matched", "matched", ","),
+    Column("missed", "missed", ","),
+    Column("missed_pct", "missed %", ".2f"),
+    Column("spurious", "spurious", ","),
+    Column("energy_drift", "dE/E", ".2e"),
+    Column("overlap", "overlap", ".3g"),
+]
+
+
+def pit_peers_section(config: Config, results: Path) -> list[dict]:
+    """discsim FixedStep against pymunk at the same dt: seconds per frame, and accuracy against PIC."""
+    pymunk = _pymunk()
+    if pymunk is None:
+        print("note: pymunk is not installed (pip install -e .[bench]); FixedStep alone")
+    else:
+        print(f"pymunk {pymunk.version}: default space (iterations 10, collision_slop 0.1, BB tree)")
+    rows = []
+    for n in sorted(set(config.pit_sizes) | set(config.pit_accuracy_sizes)):
+        discs, box = _walled_gas(n, config)
+        dt, source = frame_step(discs, config)
+        print(f"N={n:,}: walled gas phi={config.packing_fraction}, melted by PIC; dt={dt:.3g} ({source})")
+        engines = ["fixed_step"] + (["pymunk"] if pymunk is not None else [])
+        point = {e: {"n": n, "engine": e, "dt": dt} for e in engines}
+        if n in config.pit_sizes:
+            announce(f"  PIT N={n:,}: timing {config.repeats} x {config.pit_frames} frames")
+            seconds = time_frames(pymunk, discs, box, dt, config)
+            for e in engines:
+                point[e]["seconds_per_frame"] = seconds[e]
+                point[e]["pymunk_ratio"] = seconds[e] / seconds["pymunk"] if pymunk is not None else math.nan
+        if n in config.pit_accuracy_sizes:
+            horizon = config.pit_horizon_free_times / float(ds.enskog_collision_rate(config.packing_fraction))
+            announce(f"  PIT N={n:,}: accuracy against PIC over T={horizon:.3g}")
+            for e, found in judge(pymunk, discs, box, dt, horizon).items():
+                point[e].update(found, horizon=horizon)
+                point[e]["missed_pct"] = 100.0 * found["missed"] / found["truth"] if found["truth"] else math.nan
+        rows += point.values()
+    print(format_table(rows, PIT_COLUMNS))
+    write_csv(results / "peers_pit.csv", rows, [c.key for c in PIT_COLUMNS])
+    return rows
+
+
 def plot(rows: list[dict], path: Path) -> Path:
     """Collisions/s against N for each engine that ran (log-log)."""
     import matplotlib
@@ -366,11 +654,10 @@ def plot(rows: list[dict], path: Path) -> Path:
     return path
 
 
-#: The sections in run order: (title, function(config, results) -> rows). The
-#: PIT-against-pymunk section of issue 4 (seconds per frame, missed collisions
-#: against PIC, energy drift, deepest overlap) is added here by the fixed-step work.
+#: The sections in run order: (title, function(config, results) -> rows).
 SECTIONS = [
     ("PIC against peers (walled box)", pic_peers_section),
+    ("PIT against pymunk (walled box, same dt)", pit_peers_section),
 ]
 
 

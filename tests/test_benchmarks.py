@@ -64,6 +64,12 @@ def test_throughput_quick_writes_its_csv_and_plot(tmp_path):
     assert sorted(r["queue"] for r in queues) == ["heap", "sorted"]
     assert (tmp_path / "throughput.png").stat().st_size > 0
     assert "coll/s" in done.stdout
+    pit = _read_csv(tmp_path / "throughput_pit.csv")
+    assert {r["broad_phase"] for r in pit} == {"grid", "all-pairs"}
+    assert all(float(r["frames_per_s"]) > 0 and float(r["pair_tests_per_s"]) > 0 for r in pit)
+    costs = _read_csv(tmp_path / "throughput_crossover.csv")
+    assert costs and all(float(r["pic_s_per_time"]) > 0 and float(r["pit_s_per_time"]) > 0 for r in costs)
+    assert (tmp_path / "throughput_pit.png").stat().st_size > 0
 
 
 @pytest.mark.slow
@@ -76,6 +82,10 @@ def test_peers_quick_writes_its_csv_and_plot(tmp_path):
     ran = [r for r in rows if r["engine"] in ("discsim", "naive") and r["status"] == "ok"]
     assert len(ran) == 4  # 2 sizes x 2 engines
     assert (tmp_path / "peers.png").stat().st_size > 0
+    pit = _read_csv(tmp_path / "peers_pit.csv")
+    fixed = [r for r in pit if r["engine"] == "fixed_step"]
+    assert fixed and float(fixed[0]["seconds_per_frame"]) > 0
+    assert int(fixed[0]["matched"]) + int(fixed[0]["missed"]) == int(fixed[0]["truth"])
 
 
 # --- the naive baseline agrees with discsim event by event ------------------------------

@@ -1,0 +1,210 @@
+"""The PIT benchmark scripts of issue 4 (event counts, accuracy map) run in their ``--quick`` mode.
+
+Each script runs once in a subprocess into a temporary folder; the tests read
+its CSV files. No test asserts a speed: timings belong to the scripts' output.
+"""
+
+import csv
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+def _run_quick(script: str, results: Path) -> subprocess.CompletedProcess:
+    env = dict(os.environ, MPLBACKEND="Agg")
+    return subprocess.run(
+        [sys.executable, str(BENCHMARKS / script), "--quick", "--results", str(results)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
+        check=False,
+    )
+
+
+def _read_csv(path: Path) -> list[dict]:
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def _number(text: str) -> float:
+    return float(text) if text not in ("", None) else math.nan
+
+
+# --- event_counts.py -------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def event_counts(tmp_path_factory):
+    results = tmp_path_factory.mktemp("event_counts")
+    done = _run_quick("event_counts.py", results)
+    return done, results
+
+
+@pytest.mark.slow
+def test_event_counts_quick_runs_and_writes_its_files(event_counts):
+    done, results = event_counts
+    assert done.returncode == 0, done.stderr
+    assert (results / "event_counts.png").stat().st_size > 0
+    assert "missed %" in done.stdout and "work units" in done.stdout
+    rows = _read_csv(results / "event_counts.csv")
+    expected = {
+        "scenario",
+        "method",
+        "policy",
+        "fps",
+        "step",
+        "frames",
+        "pair_tests",
+        "detections",
+        "collisions",
+        "wall_hits",
+        "cell_crossings",
+        "stale",
+        "predictions",
+        "work_units",
+        "seconds",
+        "missed_pct",
+        "spurious_pct",
+        "mean_delay",
+        "max_delay",
+        "mean_direction_error_deg",
+        "max_direction_error_deg",
+        "position_error_max",
+        "max_overlap",
+        "energy_change",
+    }
+    assert expected <= set(rows[0])
+    scenarios = {r["scenario"] for r in rows}
+    assert {"missed_collision", "wrong_direction", "multiple_collisions", "delay"} <= scenarios
+    assert sum(s.startswith("gas") for s in scenarios) == 2
+
+
+@pytest.mark.slow
+def test_event_counts_pic_is_the_reference(event_counts):
+    done, results = event_counts
+    assert done.returncode == 0, done.stderr
+    rows = _read_csv(results / "event_counts.csv")
+    pic = [r for r in rows if r["method"] == "PIC"]
+    assert len(pic) == len({r["scenario"] for r in rows})
+    for row in pic:
+        # PIC against a second PIC run (the other event queue): nothing missed, nothing late.
+        assert _number(row["missed_pct"]) == 0.0
+        assert _number(row["spurious_pct"]) == 0.0
+        assert _number(row["max_delay"]) < 1e-9
+        assert _number(row["max_overlap"]) < 1e-9
+        assert int(row["predictions"]) >= int(row["collisions"]) > 0
+        assert abs(_number(row["energy_change"])) < 1e-12
+
+
+@pytest.mark.slow
+def test_event_counts_pit_work_grows_with_the_frame_rate_and_buys_accuracy(event_counts):
+    done, results = event_counts
+    assert done.returncode == 0, done.stderr
+    rows = _read_csv(results / "event_counts.csv")
+    for scenario in {r["scenario"] for r in rows}:
+        pit = [r for r in rows if r["scenario"] == scenario and r["policy"] == "resolve"]
+        pit.sort(key=lambda r: _number(r["fps"]))
+        slow, fast = pit[0], pit[-1]
+        horizon = _number(slow["horizon"])
+        assert int(slow["frames"]) == round(_number(slow["fps"]) * horizon)
+        assert int(fast["frames"]) == round(_number(fast["fps"]) * horizon)
+        assert int(fast["work_units"]) > int(slow["work_units"])
+        assert _number(fast["missed_pct"]) <= _number(slow["missed_pct"])
+        # resolve conserves kinetic energy
+        assert abs(_number(fast["energy_change"])) < 1e-12
+    missed = next(r for r in rows if r["scenario"] == "missed_collision" and r["policy"] == "resolve")
+    assert _number(missed["missed_pct"]) == 100.0  # the study's case 1 at its own frame rate
+
+
+# --- accuracy_map.py -------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def accuracy_map(tmp_path_factory):
+    results = tmp_path_factory.mktemp("accuracy_map")
+    done = _run_quick("accuracy_map.py", results)
+    return done, results
+
+
+@pytest.mark.slow
+def test_accuracy_map_quick_runs_and_writes_its_files(accuracy_map):
+    done, results = accuracy_map
+    assert done.returncode == 0, done.stderr
+    assert (results / "accuracy_map.png").stat().st_size > 0
+    assert "boundary" in done.stdout
+    rows = _read_csv(results / "accuracy_map.csv")
+    expected = {
+        "policy",
+        "packing_fraction",
+        "step",
+        "status",
+        "truth_collisions",
+        "missed_fraction",
+        "mean_direction_error_deg",
+        "mean_abs_delay_free_times",
+        "good",
+    }
+    assert expected <= set(rows[0])
+    policies = {r["policy"] for r in rows}
+    assert {"resolve", "revert", "separate"} <= policies
+    steps = {r["step"] for r in rows}
+    fractions = {r["packing_fraction"] for r in rows}
+    assert len(rows) == len(policies) * len(steps) * len(fractions)  # a full grid
+    boundary = _read_csv(results / "accuracy_map_boundary.csv")
+    assert len(boundary) == len(policies) * len(fractions)
+
+
+@pytest.mark.slow
+def test_accuracy_map_errors_grow_with_the_step(accuracy_map):
+    done, results = accuracy_map
+    assert done.returncode == 0, done.stderr
+    rows = [r for r in _read_csv(results / "accuracy_map.csv") if r["status"] == "ok"]
+    for row in rows:
+        assert int(row["truth_collisions"]) > 0
+        assert 0.0 <= _number(row["missed_fraction"]) <= 1.0
+        good = _number(row["missed_fraction"]) <= 0.01 and _number(row["mean_direction_error_deg"]) <= 1.0
+        assert (row["good"] == "True") == good
+    for policy in ("resolve", "revert", "separate"):
+        for eta in {r["packing_fraction"] for r in rows}:
+            cells = sorted(
+                (r for r in rows if r["policy"] == policy and r["packing_fraction"] == eta),
+                key=lambda r: _number(r["step"]),
+            )
+            small, large = cells[0], cells[-1]
+            assert _number(small["missed_fraction"]) <= _number(large["missed_fraction"])
+            assert _number(small["mean_direction_error_deg"]) <= _number(large["mean_direction_error_deg"])
+            assert _number(large["missed_fraction"]) > 0.5  # ten radii per frame: most collisions missed
+
+
+@pytest.mark.slow
+def test_accuracy_map_boundary_is_consistent_with_the_cells(accuracy_map):
+    done, results = accuracy_map
+    assert done.returncode == 0, done.stderr
+    rows = _read_csv(results / "accuracy_map.csv")
+    for limit in _read_csv(results / "accuracy_map_boundary.csv"):
+        cells = [
+            r for r in rows if r["policy"] == limit["policy"] and r["packing_fraction"] == limit["packing_fraction"]
+        ]
+        largest = _number(limit["largest_good_step"])
+        for cell in cells:
+            if _number(cell["step"]) <= largest:
+                assert cell["good"] == "True"
+        first_bad = _number(limit["first_bad_step"])
+        if not math.isnan(first_bad):
+            bad = next(c for c in cells if _number(c["step"]) == first_bad)
+            assert bad["good"] != "True"
+
+
+def test_accuracy_map_docstring_examples(monkeypatch):
+    import doctest
+    import importlib.util
+
+    monkeypatch.syspath_prepend(str(BENCHMARKS))  # the script imports benchutils from its own folder
+    spec = importlib.util.spec_from_file_location("accuracy_map", BENCHMARKS / "accuracy_map.py")
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "accuracy_map", module)  # its dataclasses look themselves up there
+    spec.loader.exec_module(module)
+    assert doctest.testmod(module, raise_on_error=False).failed == 0

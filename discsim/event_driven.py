@@ -672,17 +672,20 @@ class EventDriven(Engine):
         front = {_PLUS_X: (6, 7, 8), _MINUS_X: (0, 1, 2), _PLUS_Y: (2, 5, 8), _MINUS_Y: (0, 3, 6)}
         width, height, periodic = box.width, box.height, box.periodic
         # Per-cell boundaries, and whether a wall stands beyond each side.
-        xlo, xhi, ylo, yhi, wall_xlo, wall_xhi, wall_ylo, wall_yhi = ([] for _ in range(8))
-        for c in range(len(grid)):
-            cx, cy = divmod(c, grid.ny)
-            xlo.append(cx * grid.lx)
-            xhi.append(width if cx == grid.nx - 1 else (cx + 1) * grid.lx)
-            ylo.append(cy * grid.ly)
-            yhi.append(height if cy == grid.ny - 1 else (cy + 1) * grid.ly)
-            wall_xlo.append(not periodic and cx == 0)
-            wall_xhi.append(not periodic and cx == grid.nx - 1)
-            wall_ylo.append(not periodic and cy == 0)
-            wall_yhi.append(not periodic and cy == grid.ny - 1)
+        # The per-cell lists share one float per column and per row, which keeps them small.
+        col_lo = [cx * grid.lx for cx in range(grid.nx)]
+        col_hi = [*col_lo[1:], width]
+        row_lo = [cy * grid.ly for cy in range(grid.ny)]
+        row_hi = [*row_lo[1:], height]
+        columns = [cx for cx in range(grid.nx) for _ in range(grid.ny)]
+        rows = list(range(grid.ny)) * grid.nx
+        xlo, xhi = [col_lo[cx] for cx in columns], [col_hi[cx] for cx in columns]
+        ylo, yhi = [row_lo[cy] for cy in rows], [row_hi[cy] for cy in rows]
+        wall_xlo = [not periodic and cx == 0 for cx in columns]
+        wall_xhi = [not periodic and cx == grid.nx - 1 for cx in columns]
+        wall_ylo = [not periodic and cy == 0 for cy in rows]
+        wall_yhi = [not periodic and cy == grid.ny - 1 for cy in rows]
+        del columns, rows
         kept_time, kept_partner, kept_stamp = self._kept_time, self._kept_partner, self._kept_stamp
         push, discard = self._queue.push, self._queue.discard
         # Collision filter: blocked[g][h] is True when groups g and h pass through each other.

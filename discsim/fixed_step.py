@@ -437,6 +437,24 @@ class FixedStep(Engine):
                 d -= size * np.round(d / size)
             yield self._unblocked(ii, jj, d)
 
+    def _check_sweep_fits(self) -> None:
+        """Refuse a swept frame whose relative sweeps could reach a second periodic image.
+
+        The swept test follows one image per pair (the nearest at mid-frame), which
+        is exact while two discs' relative path over a frame plus their contact
+        distance stays under half the box's shorter side.
+        """
+        speed = float(np.sqrt(np.max(np.einsum("ij,ij->i", self._vel, self._vel), initial=0.0)))
+        reach = 2.0 * speed * self.dt + 2.0 * self._max_radius
+        half = 0.5 * min(self.box.width, self.box.height)
+        if reach >= half:
+            msg = (
+                f"policy 'swept' in a periodic box needs 2 v_max dt + 2 r_max < half the box side: "
+                f"2 * {speed:.6g} * {self.dt:.6g} + {2.0 * self._max_radius:.6g} = {reach:.6g} >= {half:.6g}; "
+                "use a smaller dt or a larger box"
+            )
+            raise ValueError(msg)
+
     def _listed_pairs(self, pos: np.ndarray):
         """Candidate pairs from a Verlet list: the pairs within ``2 r_max + skin`` when it was built.
 
@@ -499,6 +517,8 @@ class FixedStep(Engine):
         return i[hit], j[hit]
 
     def _frame(self) -> list[Event]:
+        if self.policy == "swept" and self.box.periodic:
+            self._check_sweep_fits()
         if self.policy in SUB_FRAME_POLICIES:
             return _SubFrame(self).run()
         k = self.frames + 1

@@ -523,3 +523,15 @@ def test_pit_variants_benchmark_quick_writes_its_table(tmp_path):
     for row in rows:
         assert float(row["seconds"]) > 0
     assert "swept" in done.stdout and "bisection" in done.stdout
+
+
+def test_swept_refuses_frames_whose_sweeps_wrap_a_periodic_box():
+    discs, box = ds.random_gas(60, 0.45, periodic=True, seed=1, temperature=0.5)
+    sim = ds.FixedStep(discs, box, dt=10.0, policy="swept")
+    before = (sim.time, sim.positions.copy(), sim.velocities.copy())
+    with pytest.raises(ValueError, match="half the box side"):
+        sim.step()
+    assert sim.time == before[0]
+    np.testing.assert_array_equal(sim.positions, before[1])
+    np.testing.assert_array_equal(sim.velocities, before[2])
+    ds.FixedStep(discs, box, dt=0.5, policy="swept").run(frames=3)  # small frames are fine

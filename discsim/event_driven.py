@@ -29,11 +29,11 @@ import numpy as np
 from discsim.engine import Engine, Event
 from discsim.errors import CheckpointError
 from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, EventLog, stream_header
-from discsim.grid import CellGrid, check_fits
+from discsim.grid import CellGrid, check_fits, check_scene
 from discsim.io import RecordWriter, read_state, write_state
 from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
 from discsim.queue import EventQueue, HeapEventQueue
-from discsim.state import Box, Discs, Segment, normalize_pass_through
+from discsim.state import Box, Discs, Segment
 
 __all__ = ["EventDriven"]
 
@@ -134,16 +134,7 @@ class EventDriven(Engine):
         if queue not in _QUEUES:
             msg = f"queue must be one of {sorted(_QUEUES)}, got {queue!r}"
             raise ValueError(msg)
-        segments = tuple(segments)
-        for k, segment in enumerate(segments):
-            if not isinstance(segment, Segment):
-                msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
-                raise TypeError(msg)
-        if segments and box.periodic:
-            msg = "segments need a box with walls (periodic=False)"
-            raise ValueError(msg)
-        pass_through = normalize_pass_through(pass_through)
-        check_fits(discs, box, segments=segments, pass_through=pass_through)
+        segments, pass_through = check_scene(discs, box, segments, pass_through)
         n = len(discs)
         diameter = 2.0 * float(discs.radii.max()) if n else 1.0
         if cell_size is None:

@@ -81,7 +81,7 @@ import numpy as np
 
 from discsim.engine import Engine, Event
 from discsim.eventlog import EventLog
-from discsim.grid import CellGrid, check_fits, neighbour_pairs
+from discsim.grid import CellGrid, check_scene, neighbour_pairs
 from discsim.kernels import (
     closest_point_on_segment,
     reflect_off_segment,
@@ -91,7 +91,7 @@ from discsim.kernels import (
     time_of_impact_bisect,
     wall_time,
 )
-from discsim.state import Box, Discs, Segment, normalize_pass_through
+from discsim.state import Box, Discs
 
 __all__ = ["BROAD_PHASES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
 
@@ -229,16 +229,7 @@ class FixedStep(Engine):
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise ValueError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else _positive_finite("bisect_tol", bisect_tol)
-        segments = tuple(segments)
-        for k, segment in enumerate(segments):
-            if not isinstance(segment, Segment):
-                msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
-                raise TypeError(msg)
-        if segments and box.periodic:
-            msg = "segments need a box with walls (periodic=False)"
-            raise ValueError(msg)
-        pass_through = normalize_pass_through(pass_through)
-        check_fits(discs, box, segments=segments, pass_through=pass_through)
+        segments, pass_through = check_scene(discs, box, segments, pass_through)
         n = len(discs)
         diameter = 2.0 * float(discs.radii.max()) if n else 1.0
         # The same box check as EventDriven's cell grid (a periodic box needs 3 cells a side);

@@ -13,9 +13,9 @@ import math
 import numpy as np
 
 from discsim.errors import BoxTooSmallError, OutsideBoxError, OverlapError
-from discsim.state import OVERLAP_TOLERANCE, Box, Discs
+from discsim.state import OVERLAP_TOLERANCE, Box, Discs, Segment, normalize_pass_through
 
-__all__ = ["CellGrid", "check_fits", "neighbour_pairs"]
+__all__ = ["CellGrid", "check_fits", "check_scene", "neighbour_pairs"]
 
 
 def _cells_along(length: float, min_cell: float, periodic: bool, axis: str) -> int:
@@ -273,3 +273,27 @@ def check_fits(
             f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
         )
         raise OverlapError(msg)
+
+
+def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[tuple[Segment, ...], frozenset]:
+    """Validate what an engine is given: segments, the collision filter, and :func:`check_fits`.
+
+    Returns:
+        ``(segments, pass_through)`` as a tuple of segments and a frozenset of sorted group pairs.
+
+    Raises:
+        TypeError: if a segment is not a :class:`~discsim.state.Segment`.
+        ValueError: if segments are given with a periodic box.
+        OutsideBoxError, OverlapError: from :func:`check_fits`.
+    """
+    segments = tuple(segments)
+    for k, segment in enumerate(segments):
+        if not isinstance(segment, Segment):
+            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
+            raise TypeError(msg)
+    if segments and box.periodic:
+        msg = "segments need a box with walls (periodic=False)"
+        raise ValueError(msg)
+    pass_through = normalize_pass_through(pass_through)
+    check_fits(discs, box, segments=segments, pass_through=pass_through)
+    return segments, pass_through

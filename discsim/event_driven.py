@@ -866,6 +866,11 @@ class EventDriven(Engine):
                 if moving[j]:
                     count[j] += 1
                     predict(j, t, i)
+                    # Only here can the queue grow (j's slot may have been empty); other
+                    # events pop their owner's event and push at most one back.
+                    size = len(queue)
+                    if size > max_queue:
+                        max_queue = size
                 last = (t + epoch, _COLLISION, i, j)
             elif kind == _WALL:
                 dt = t - tr[i]
@@ -926,9 +931,6 @@ class EventDriven(Engine):
                 n_cross += 1
                 predict(i, t, -1, other)
             now = t
-            size = len(queue)
-            if size > max_queue:
-                max_queue = size
             if done >= rebase_at:
                 self._rebase(now)
                 epoch, now = self._epoch, 0.0

@@ -1,9 +1,12 @@
 """The event-driven engine (PIC): jump from one predicted collision to the next.
 
-State is a struct of plain Python lists (the hot loop reads floats, not numpy
-scalars). Each disc carries a reference position ``r`` at its own reference
-time ``tr`` and flies straight, ``r + v (t - tr)``, until its velocity
-changes: an event touches only the discs it involves (lazy clocks).
+State is one plain Python list of per-disc records, tuples
+``(x, y, vx, vy, t_ref, radius)`` (the hot loop reads floats, not numpy
+scalars, and one tuple unpack fetches a neighbour's whole state: fewer
+bytecodes and fewer cache misses than six parallel lists). Each disc flies
+straight from its reference position at its own reference time,
+``r + v (t - t_ref)``, until its velocity changes: an event touches only the
+discs it involves (lazy clocks).
 
 Each moving disc owns at most one pending event in the queue: the earliest of
 its next wall hit, its next cell crossing and its next collision with a disc
@@ -103,9 +106,16 @@ class EventDriven(Engine):
         n = len(discs)
         grid = self.grid
         pos, vel = discs.positions, discs.velocities
-        self._rx, self._ry = pos[:, 0].tolist(), pos[:, 1].tolist()
-        self._vx, self._vy = vel[:, 0].tolist(), vel[:, 1].tolist()
-        self._tr = [0.0] * n
+        self._disc = list(
+            zip(
+                pos[:, 0].tolist(),
+                pos[:, 1].tolist(),
+                vel[:, 0].tolist(),
+                vel[:, 1].tolist(),
+                [0.0] * n,
+                discs.radii.tolist(),
+            )
+        )
         self._radius = discs.radii.tolist()
         self._mass = discs.masses.tolist()
         self._moving = np.isfinite(discs.masses).tolist()
@@ -156,17 +166,25 @@ class EventDriven(Engine):
         self._rebase_every = max(_REBASE_EVENTS, 16 * n)
 
     # --- saving and restoring ----------------------------------------------------------
-    _STATE_FLOATS = ("_rx", "_ry", "_vx", "_vy", "_tr", "_kept_time")
+    # The per-disc records are saved as one array per field (the file format predates the records).
+    _RECORD_FIELDS = ("_rx", "_ry", "_vx", "_vy", "_tr")
+    _STATE_FLOATS = ("_kept_time",)
     _STATE_INTS = ("_count", "_cell", "_kept_partner", "_kept_stamp")
+
+    def _records(self) -> np.ndarray:
+        """The per-disc records as an ``(N, 6)`` array: x, y, vx, vy, t_ref, radius."""
+        return np.array(self._disc, dtype=np.float64).reshape(-1, 6)
 
     def _get_state(self) -> dict:
         """Everything needed to continue bit for bit, as numpy arrays and plain numbers."""
-        state = {name: np.array(getattr(self, name), dtype=np.float64) for name in self._STATE_FLOATS}
+        records = self._records()
+        state = {name: records[:, k].copy() for k, name in enumerate(self._RECORD_FIELDS)}
+        state.update({name: np.array(getattr(self, name), dtype=np.float64) for name in self._STATE_FLOATS})
         state.update({name: np.array(getattr(self, name), dtype=np.int64) for name in self._STATE_INTS})
         # Order within a cell decides ties, so it is saved too.
         state["cell_members"] = np.array([j for members in self._cells for j in members], dtype=np.int64)
         state["cell_sizes"] = np.array([len(members) for members in self._cells], dtype=np.int64)
-        pending = [(o, *self._queue.pending(o)) for o in range(len(self._rx))]
+        pending = [(o, *self._queue.pending(o)) for o in range(len(self._disc))]
         pending = [(o, t, p) for o, t, p in pending if t != INF]
         state["queue_owner"] = np.array([o for o, _, _ in pending], dtype=np.int64)
         state["queue_time"] = np.array([t for _, t, _ in pending], dtype=np.float64)
@@ -209,6 +227,8 @@ class EventDriven(Engine):
         )
         for name in cls._STATE_FLOATS + cls._STATE_INTS:
             setattr(sim, name, state[name].tolist())
+        fields = [state[name].tolist() for name in cls._RECORD_FIELDS]
+        sim._disc = list(zip(*fields, sim._radius))
         sizes = state["cell_sizes"].tolist()
         members = state["cell_members"].tolist()
         sim._cells, k = [], 0
@@ -239,15 +259,14 @@ class EventDriven(Engine):
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
         t = self.time - self._epoch
-        rx, ry, tr = np.array(self._rx), np.array(self._ry), np.array(self._tr)
-        vx, vy = np.array(self._vx), np.array(self._vy)
+        rx, ry, vx, vy, tr, _ = self._records().T
         out = np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)])
         return self.box.wrap(out) if len(out) else out.reshape(0, 2)
 
     @property
     def velocities(self) -> np.ndarray:
         """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
-        return np.column_stack([self._vx, self._vy]) if self._vx else np.zeros((0, 2))
+        return self._records()[:, 2:4].copy()
 
     def _event_array(self) -> np.ndarray:
         return self._log.to_array()
@@ -654,7 +673,7 @@ class EventDriven(Engine):
 
         The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
         """
-        rx, ry, vx, vy, tr, radius = self._rx, self._ry, self._vx, self._vy, self._tr, self._radius
+        disc = self._disc
         cell, count = self._cell, self._count
         grid, box = self.grid, self.box
         nobody: list[int] = []  # stands for the cells a wall cuts off
@@ -694,11 +713,10 @@ class EventDriven(Engine):
         def predict(i: int, t: float, exclude: int, direction: int = -1) -> None:
             nonlocal n_pred
             n_pred += 1
-            vxi, vyi = vx[i], vy[i]
-            dti = t - tr[i]
-            xi = rx[i] + vxi * dti
-            yi = ry[i] + vyi * dti
-            ri = radius[i]
+            xi, yi, vxi, vyi, ti, ri = disc[i]
+            dti = t - ti
+            xi += vxi * dti
+            yi += vyi * dti
             c = cell[i]
             # 1. The earliest collision with a neighbour.
             partner = kept_partner[i]
@@ -718,24 +736,25 @@ class EventDriven(Engine):
                 for j in members:
                     if j == i or j == exclude or (filtering and passes[group[j]]):
                         continue
-                    dvx = vx[j] - vxi
-                    dvy = vy[j] - vyi
-                    dtj = t - tr[j]
-                    dx = rx[j] + vx[j] * dtj + ox
-                    dy = ry[j] + vy[j] * dtj + oy
+                    xj, yj, vxj, vyj, tj, rj = disc[j]
+                    dvx = vxj - vxi
+                    dvy = vyj - vyi
+                    dtj = t - tj
+                    dx = xj + vxj * dtj + ox
+                    dy = yj + vyj * dtj + oy
                     b = dx * dvx + dy * dvy
                     if b >= 0.0:
                         continue
-                    s = ri + radius[j]
+                    s = ri + rj
                     cc = dx * dx + dy * dy - s * s
                     if cc <= 0.0:
                         tij = 0.0
                     else:
                         a = dvx * dvx + dvy * dvy
-                        disc = b * b - a * cc
-                        if disc <= 0.0:
+                        d = b * b - a * cc
+                        if d <= 0.0:
                             continue
-                        tij = cc / (-b + sqrt(disc))
+                        tij = cc / (-b + sqrt(d))
                     if tij < best:
                         best, new_partner = tij, j
             if after_crossing:
@@ -808,7 +827,7 @@ class EventDriven(Engine):
         queue = self._queue
         pop_before = queue.pop_before
         predict = self._predict
-        rx, ry, vx, vy, tr = self._rx, self._ry, self._vx, self._vy, self._tr
+        disc = self._disc
         count, mass, moving = self._count, self._mass, self._moving
         cell, cells, grid = self._cell, self._cells, self.grid
         nx, ny = grid.nx, grid.ny
@@ -820,7 +839,7 @@ class EventDriven(Engine):
         done = 0
         max_queue = self.max_queue
         now, last, virial = None, None, self._virial
-        radius, sqrt, max_overlap = self._radius, math.sqrt, self.max_overlap
+        sqrt, max_overlap = math.sqrt, self.max_overlap
         # Internal times run from the epoch, which moves every REBASE_EVERY physical events.
         epoch = self._epoch
         horizon = until - epoch
@@ -837,25 +856,24 @@ class EventDriven(Engine):
                     predict(i, t, -1)
                     continue
                 # Advance the two discs to the contact.
-                dt = t - tr[i]
-                xi = rx[i] = rx[i] + vx[i] * dt
-                yi = ry[i] = ry[i] + vy[i] * dt
-                tr[i] = t
-                dt = t - tr[j]
-                xj = rx[j] = rx[j] + vx[j] * dt
-                yj = ry[j] = ry[j] + vy[j] * dt
-                tr[j] = t
+                xi, yi, vxi, vyi, ti, ri = disc[i]
+                dt = t - ti
+                xi += vxi * dt
+                yi += vyi * dt
+                xj, yj, vxj, vyj, tj, rj = disc[j]
+                dt = t - tj
+                xj += vxj * dt
+                yj += vyj * dt
                 dx, dy = xj - xi, yj - yi
                 if periodic:
                     dx -= width * round(dx / width)
                     dy -= height * round(dy / height)
-                sigma = radius[i] + radius[j]
-                overlap = 1.0 - sqrt(dx * dx + dy * dy) / sigma
+                overlap = 1.0 - sqrt(dx * dx + dy * dy) / (ri + rj)
                 if overlap > max_overlap:
                     max_overlap = overlap
-                vxi, vyi, vxj, vyj = vx[i], vy[i], vx[j], vy[j]
                 uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mass[i], mass[j])
-                vx[i], vy[i], vx[j], vy[j] = uxi, uyi, uxj, uyj
+                disc[i] = (xi, yi, uxi, uyi, t, ri)
+                disc[j] = (xj, yj, uxj, uyj, t, rj)
                 virial -= mass[i] * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
                 count[i] += 1
                 n_coll += 1
@@ -873,32 +891,34 @@ class EventDriven(Engine):
                         max_queue = size
                 last = (t + epoch, _COLLISION, i, j)
             elif kind == _WALL:
-                dt = t - tr[i]
-                xi = rx[i] = rx[i] + vx[i] * dt
-                yi = ry[i] = ry[i] + vy[i] * dt
-                tr[i] = t
+                xi, yi, vxi, vyi, ti, ri = disc[i]
+                dt = t - ti
+                xi += vxi * dt
+                yi += vyi * dt
                 if other == 0:
-                    vx[i] = -vx[i]
+                    vxi = -vxi
                 else:
-                    vy[i] = -vy[i]
+                    vyi = -vyi
+                disc[i] = (xi, yi, vxi, vyi, t, ri)
                 count[i] += 1
                 n_wall += 1
                 done += 1
                 if log is not None:
-                    log.wall(t + epoch, i, xi, yi, vx[i], vy[i])
+                    log.wall(t + epoch, i, xi, yi, vxi, vyi)
                 predict(i, t, -1)
                 last = (t + epoch, _WALL, i, -1)
             elif kind == _SEGMENT:
-                dt = t - tr[i]
-                xi = rx[i] = rx[i] + vx[i] * dt
-                yi = ry[i] = ry[i] + vy[i] * dt
-                tr[i] = t
-                vx[i], vy[i] = reflect_off_segment(xi, yi, vx[i], vy[i], *segment_ends[other])
+                xi, yi, vxi, vyi, ti, ri = disc[i]
+                dt = t - ti
+                xi += vxi * dt
+                yi += vyi * dt
+                vxi, vyi = reflect_off_segment(xi, yi, vxi, vyi, *segment_ends[other])
+                disc[i] = (xi, yi, vxi, vyi, t, ri)
                 count[i] += 1
                 n_wall += 1
                 done += 1
                 if log is not None:
-                    log.wall(t + epoch, i, xi, yi, vx[i], vy[i])
+                    log.wall(t + epoch, i, xi, yi, vxi, vyi)
                 predict(i, t, -2 - other)  # never the same segment again straight away
                 last = (t + epoch, _WALL, i, -1)
             else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
@@ -909,22 +929,26 @@ class EventDriven(Engine):
                     cx += 1
                     if cx == nx:
                         cx = 0
-                        rx[i] -= width
+                        xi, yi, vxi, vyi, ti, ri = disc[i]
+                        disc[i] = (xi - width, yi, vxi, vyi, ti, ri)
                 elif other == _MINUS_X:
                     cx -= 1
                     if cx < 0:
                         cx = nx - 1
-                        rx[i] += width
+                        xi, yi, vxi, vyi, ti, ri = disc[i]
+                        disc[i] = (xi + width, yi, vxi, vyi, ti, ri)
                 elif other == _PLUS_Y:
                     cy += 1
                     if cy == ny:
                         cy = 0
-                        ry[i] -= height
+                        xi, yi, vxi, vyi, ti, ri = disc[i]
+                        disc[i] = (xi, yi - height, vxi, vyi, ti, ri)
                 else:
                     cy -= 1
                     if cy < 0:
                         cy = ny - 1
-                        ry[i] += height
+                        xi, yi, vxi, vyi, ti, ri = disc[i]
+                        disc[i] = (xi, yi + height, vxi, vyi, ti, ri)
                 c = cx * ny + cy
                 cell[i] = c
                 cells[c].append(i)
@@ -958,7 +982,7 @@ class EventDriven(Engine):
         it goes on. O(N log N); the hot loop calls it every ``_rebase_every``
         physical events, a count that does not depend on how a run is split.
         """
-        self._tr[:] = [t - shift for t in self._tr]
+        self._disc[:] = [(x, y, vx, vy, t - shift, r) for x, y, vx, vy, t, r in self._disc]
         self._kept_time[:] = [t - shift for t in self._kept_time]
         self._queue.shift_times(shift)
         self._epoch += shift
@@ -990,6 +1014,6 @@ class EventDriven(Engine):
                 assert inside_x and inside_y, f"disc {i} at {pos[i]} is not in its cell {c}"
             t_pending, payload = self._queue.pending(i)
             assert t_pending >= self.time - self._epoch - 1e-12 * max(1.0, self.time)
-            if self._moving[i] and (self._vx[i] or self._vy[i]):
+            if self._moving[i] and (self._disc[i][2] or self._disc[i][3]):
                 assert payload is not None or t_pending == INF
         check_fits(Discs(pos, self.velocities, self.discs.radii, self.discs.masses), self.box)

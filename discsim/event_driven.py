@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import math
 import uuid
+from operator import itemgetter
 from pathlib import Path
 
 import numpy as np
@@ -121,9 +122,12 @@ class EventDriven(Engine):
         self._moving = np.isfinite(discs.masses).tolist()
         self._count = [0] * n
         self._cell = grid.cells_of(pos).tolist()
-        self._cells: list[list[int]] = [[] for _ in range(len(grid))]
+        members: list[list[int]] = [[] for _ in range(len(grid))]
         for i, c in enumerate(self._cell):
-            self._cells[c].append(i)
+            members[c].append(i)
+        # One tuple per cell, plus an always-empty one that stands for the cells a wall cuts
+        # off. Empty cells share the one empty tuple, so scanning them touches no memory.
+        self._cells: list[tuple[int, ...]] = [tuple(m) for m in members] + [()]
         self._kept_time, self._kept_partner, self._kept_stamp = [INF] * n, [-1] * n, [0] * n
         self._queue = _QUEUES[queue](n)
         self._log = EventLog()
@@ -182,8 +186,9 @@ class EventDriven(Engine):
         state.update({name: np.array(getattr(self, name), dtype=np.float64) for name in self._STATE_FLOATS})
         state.update({name: np.array(getattr(self, name), dtype=np.int64) for name in self._STATE_INTS})
         # Order within a cell decides ties, so it is saved too.
-        state["cell_members"] = np.array([j for members in self._cells for j in members], dtype=np.int64)
-        state["cell_sizes"] = np.array([len(members) for members in self._cells], dtype=np.int64)
+        cells = self._cells[:-1]  # not the always-empty one
+        state["cell_members"] = np.array([j for members in cells for j in members], dtype=np.int64)
+        state["cell_sizes"] = np.array([len(members) for members in cells], dtype=np.int64)
         pending = [(o, *self._queue.pending(o)) for o in range(len(self._disc))]
         pending = [(o, t, p) for o, t, p in pending if t != INF]
         state["queue_owner"] = np.array([o for o, _, _ in pending], dtype=np.int64)
@@ -233,8 +238,9 @@ class EventDriven(Engine):
         members = state["cell_members"].tolist()
         sim._cells, k = [], 0
         for size in sizes:
-            sim._cells.append(members[k : k + size])
+            sim._cells.append(tuple(members[k : k + size]))
             k += size
+        sim._cells.append(())
         sim._queue = _QUEUES[settings["queue"]](len(discs))
         for owner, t, payload in zip(
             state["queue_owner"].tolist(), state["queue_time"].tolist(), state["queue_payload"].tolist()
@@ -676,26 +682,32 @@ class EventDriven(Engine):
         disc = self._disc
         cell, count = self._cell, self._count
         grid, box = self.grid, self.box
-        nobody: list[int] = []  # stands for the cells a wall cuts off
-        blocks = [tuple(self._cells[c2] if c2 >= 0 else nobody for c2 in grid.neighbours[c]) for c in range(len(grid))]
-        shifts = grid.shifts
+        members = self._cells
         front = {_PLUS_X: (6, 7, 8), _MINUS_X: (0, 1, 2), _PLUS_Y: (2, 5, 8), _MINUS_Y: (0, 3, 6)}
         width, height, periodic = box.width, box.height, box.periodic
-        # Per-cell boundaries, and whether a wall stands beyond each side.
-        # The per-cell lists share one float per column and per row, which keeps them small.
+        # Segments near each cell (a static structure built once).
+        segment_ends = [(*s.p0.tolist(), *s.p1.tolist()) for s in self.segments]
+        reach = max(self._radius, default=0.0)
+        segments_near = grid.segments_by_cell(self.segments, reach) if segment_ends else [()] * len(grid)
+        # One static record per cell, so a prediction reads one tuple:
+        # (members of the 3x3 block, their minimum-image shifts, xlo, xhi, ylo, yhi, walls, segments).
+        # ``itemgetter`` fetches the 9 member tuples in one call; cells a wall cuts off
+        # read the always-empty last entry. ``walls`` has bit 1, 2, 4, 8 set when a wall
+        # stands beyond the low-x, high-x, low-y, high-y side. Records share one float
+        # per column and per row, which keeps them small.
+        empty = len(grid)
         col_lo = [cx * grid.lx for cx in range(grid.nx)]
         col_hi = [*col_lo[1:], width]
         row_lo = [cy * grid.ly for cy in range(grid.ny)]
         row_hi = [*row_lo[1:], height]
-        columns = [cx for cx in range(grid.nx) for _ in range(grid.ny)]
-        rows = list(range(grid.ny)) * grid.nx
-        xlo, xhi = [col_lo[cx] for cx in columns], [col_hi[cx] for cx in columns]
-        ylo, yhi = [row_lo[cy] for cy in rows], [row_hi[cy] for cy in rows]
-        wall_xlo = [not periodic and cx == 0 for cx in columns]
-        wall_xhi = [not periodic and cx == grid.nx - 1 for cx in columns]
-        wall_ylo = [not periodic and cy == 0 for cy in rows]
-        wall_yhi = [not periodic and cy == grid.ny - 1 for cy in rows]
-        del columns, rows
+        info = []
+        for c, (near, shift, segs) in enumerate(zip(grid.neighbours, grid.shifts, segments_near)):
+            cx, cy = divmod(c, grid.ny)
+            walls = (
+                0 if periodic else ((cx == 0) | (cx == grid.nx - 1) << 1 | (cy == 0) << 2 | (cy == grid.ny - 1) << 3)
+            )
+            block = itemgetter(*(c2 if c2 >= 0 else empty for c2 in near))
+            info.append((block, shift, col_lo[cx], col_hi[cx], row_lo[cy], row_hi[cy], walls, segs))
         kept_time, kept_partner, kept_stamp = self._kept_time, self._kept_partner, self._kept_stamp
         push, discard = self._queue.push, self._queue.discard
         # Collision filter: blocked[g][h] is True when groups g and h pass through each other.
@@ -704,10 +716,6 @@ class EventDriven(Engine):
         index = {g: k for k, g in enumerate(labels)}
         group = [index[g] for g in self.discs.groups.tolist()]
         blocked = [[(min(g, h), max(g, h)) in self.pass_through for h in labels] for g in labels]
-        # Segments near each cell (a static structure built once).
-        segment_ends = [(*s.p0.tolist(), *s.p1.tolist()) for s in self.segments]
-        reach = max(self._radius, default=0.0)
-        segments_near = grid.segments_by_cell(self.segments, reach) if segment_ends else [()] * len(grid)
         sqrt = math.sqrt
 
         def predict(i: int, t: float, exclude: int, direction: int = -1) -> None:
@@ -717,23 +725,23 @@ class EventDriven(Engine):
             dti = t - ti
             xi += vxi * dti
             yi += vyi * dti
-            c = cell[i]
+            block, shift, x_lo, x_hi, y_lo, y_hi, walls, segs = info[cell[i]]
+            block = block(members)
             # 1. The earliest collision with a neighbour.
             partner = kept_partner[i]
             after_crossing = direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i])
             if after_crossing:  # the 3 cells that just became adjacent; the kept collision covers the other 6
-                block, shift = blocks[c], shifts[c]
                 k0, k1, k2 = front[direction]
                 near = ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2]))
             else:
-                near = zip(blocks[c], shifts[c])
+                near = zip(block, shift)
             best, new_partner = INF, -1
             passes = blocked[group[i]] if filtering else None
-            for members, (sx, sy) in near:
-                if not members:
+            for others, (sx, sy) in near:
+                if not others:
                     continue
                 ox, oy = sx - xi, sy - yi
-                for j in members:
+                for j in others:
                     if j == i or j == exclude or (filtering and passes[group[j]]):
                         continue
                     xj, yj, vxj, vyj, tj, rj = disc[j]
@@ -770,34 +778,34 @@ class EventDriven(Engine):
             # 2. The next wall, segment or cell boundary.
             best, kind, other = INF, _CROSSING, 0
             if vxi > 0.0:
-                if wall_xhi[c]:
+                if walls & 2:
                     best, kind = (width - ri - xi) / vxi, _WALL
                 else:
-                    best, other = (xhi[c] - xi) / vxi, _PLUS_X
+                    best, other = (x_hi - xi) / vxi, _PLUS_X
             elif vxi < 0.0:
-                if wall_xlo[c]:
+                if walls & 1:
                     best, kind = (ri - xi) / vxi, _WALL
                 else:
-                    best, other = (xlo[c] - xi) / vxi, _MINUS_X
+                    best, other = (x_lo - xi) / vxi, _MINUS_X
             if vyi > 0.0:
-                if wall_yhi[c]:
+                if walls & 8:
                     ty = (height - ri - yi) / vyi
                     if ty < best:
                         best, kind, other = ty, _WALL, 1
                 else:
-                    ty = (yhi[c] - yi) / vyi
+                    ty = (y_hi - yi) / vyi
                     if ty < best:
                         best, kind, other = ty, _CROSSING, _PLUS_Y
             elif vyi < 0.0:
-                if wall_ylo[c]:
+                if walls & 4:
                     ty = (ri - yi) / vyi
                     if ty < best:
                         best, kind, other = ty, _WALL, 1
                 else:
-                    ty = (ylo[c] - yi) / vyi
+                    ty = (y_lo - yi) / vyi
                     if ty < best:
                         best, kind, other = ty, _CROSSING, _MINUS_Y
-            for k in segments_near[c]:
+            for k in segs:
                 if k != -2 - exclude:  # not the segment just left
                     ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, *segment_ends[k])
                     if ts < best:
@@ -923,7 +931,12 @@ class EventDriven(Engine):
                 last = (t + epoch, _WALL, i, -1)
             else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
                 c = cell[i]
-                cells[c].remove(i)
+                others = cells[c]
+                if len(others) == 1:
+                    cells[c] = ()
+                else:
+                    k = others.index(i)
+                    cells[c] = others[:k] + others[k + 1 :]
                 cx, cy = divmod(c, ny)
                 if other == _PLUS_X:
                     cx += 1
@@ -951,7 +964,7 @@ class EventDriven(Engine):
                         disc[i] = (xi, yi + height, vxi, vyi, ti, ri)
                 c = cx * ny + cy
                 cell[i] = c
-                cells[c].append(i)
+                cells[c] += (i,)
                 n_cross += 1
                 predict(i, t, -1, other)
             now = t
@@ -993,6 +1006,7 @@ class EventDriven(Engine):
         self._queue._check()
         n = len(self.discs)
         assert len(self._queue) <= n
+        assert len(self._cells) == len(self.grid) + 1 and self._cells[-1] == ()
         seen = sorted(j for members in self._cells for j in members)
         assert seen == list(range(n)), "every disc is in exactly one cell"
         pos = self.positions

@@ -1,12 +1,14 @@
 """The event-driven engine (PIC): jump from one predicted collision to the next.
 
-State is one plain Python list of per-disc records, tuples
-``(x, y, vx, vy, t_ref, radius)`` (the hot loop reads floats, not numpy
-scalars, and one tuple unpack fetches a neighbour's whole state: fewer
-bytecodes and fewer cache misses than six parallel lists). Each disc flies
-straight from its reference position at its own reference time,
-``r + v (t - t_ref)``, until its velocity changes: an event touches only the
-discs it involves (lazy clocks).
+State is one ``bytearray`` of per-disc records, six float64 each:
+``(x, y, vx, vy, t_ref, radius)``, read and written with one
+:class:`struct.Struct` call (the hot loop works on Python floats, not numpy
+scalars). A record is 48 contiguous bytes, so fetching a neighbour costs one
+cache line: Python lists of float objects cost several, which made large
+systems slow (same-process A/B against lists of tuples: -6% at N = 10^3,
++10% at 10^4, +13% at 10^5). Each disc flies straight from its reference
+position at its own reference time, ``r + v (t - t_ref)``, until its
+velocity changes: an event touches only the discs it involves (lazy clocks).
 
 Each moving disc owns at most one pending event in the queue: the earliest of
 its next wall hit, its next cell crossing and its next collision with a disc
@@ -24,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import struct
 import uuid
 from operator import itemgetter
 from pathlib import Path
@@ -40,6 +43,10 @@ from discsim.queue import EventQueue, HeapEventQueue
 from discsim.state import Box, Discs, Segment
 
 __all__ = ["EventDriven"]
+
+# A disc's record in the state buffer: x, y, vx, vy, t_ref, radius (float64).
+_RECORD = struct.Struct("6d")
+_RECORD_BYTES = _RECORD.size
 
 INF = math.inf
 # Kinds of queued events. COLLISION and WALL match discsim.eventlog.
@@ -107,16 +114,7 @@ class EventDriven(Engine):
         n = len(discs)
         grid = self.grid
         pos, vel = discs.positions, discs.velocities
-        self._disc = list(
-            zip(
-                pos[:, 0].tolist(),
-                pos[:, 1].tolist(),
-                vel[:, 0].tolist(),
-                vel[:, 1].tolist(),
-                [0.0] * n,
-                discs.radii.tolist(),
-            )
-        )
+        self._disc = _pack_records(pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1], np.zeros(n), discs.radii)
         self._radius = discs.radii.tolist()
         self._mass = discs.masses.tolist()
         self._moving = np.isfinite(discs.masses).tolist()
@@ -177,7 +175,7 @@ class EventDriven(Engine):
 
     def _records(self) -> np.ndarray:
         """The per-disc records as an ``(N, 6)`` array: x, y, vx, vy, t_ref, radius."""
-        return np.array(self._disc, dtype=np.float64).reshape(-1, 6)
+        return np.frombuffer(self._disc, dtype=np.float64).reshape(-1, 6).copy()
 
     def _get_state(self) -> dict:
         """Everything needed to continue bit for bit, as numpy arrays and plain numbers."""
@@ -189,7 +187,7 @@ class EventDriven(Engine):
         cells = self._cells[:-1]  # not the always-empty one
         state["cell_members"] = np.array([j for members in cells for j in members], dtype=np.int64)
         state["cell_sizes"] = np.array([len(members) for members in cells], dtype=np.int64)
-        pending = [(o, *self._queue.pending(o)) for o in range(len(self._disc))]
+        pending = [(o, *self._queue.pending(o)) for o in range(len(self.discs))]
         pending = [(o, t, p) for o, t, p in pending if t != INF]
         state["queue_owner"] = np.array([o for o, _, _ in pending], dtype=np.int64)
         state["queue_time"] = np.array([t for _, t, _ in pending], dtype=np.float64)
@@ -232,8 +230,7 @@ class EventDriven(Engine):
         )
         for name in cls._STATE_FLOATS + cls._STATE_INTS:
             setattr(sim, name, state[name].tolist())
-        fields = [state[name].tolist() for name in cls._RECORD_FIELDS]
-        sim._disc = list(zip(*fields, sim._radius))
+        sim._disc = _pack_records(*(state[name] for name in cls._RECORD_FIELDS), discs.radii)
         sizes = state["cell_sizes"].tolist()
         members = state["cell_members"].tolist()
         sim._cells, k = [], 0
@@ -679,7 +676,7 @@ class EventDriven(Engine):
 
         The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
         """
-        disc = self._disc
+        disc, unpack = self._disc, _RECORD.unpack_from
         cell, count = self._cell, self._count
         grid, box = self.grid, self.box
         members = self._cells
@@ -721,7 +718,7 @@ class EventDriven(Engine):
         def predict(i: int, t: float, exclude: int, direction: int = -1) -> None:
             nonlocal n_pred
             n_pred += 1
-            xi, yi, vxi, vyi, ti, ri = disc[i]
+            xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
             dti = t - ti
             xi += vxi * dti
             yi += vyi * dti
@@ -744,7 +741,7 @@ class EventDriven(Engine):
                 for j in others:
                     if j == i or j == exclude or (filtering and passes[group[j]]):
                         continue
-                    xj, yj, vxj, vyj, tj, rj = disc[j]
+                    xj, yj, vxj, vyj, tj, rj = unpack(disc, j * _RECORD_BYTES)
                     dvx = vxj - vxi
                     dvy = vyj - vyi
                     dtj = t - tj
@@ -835,7 +832,7 @@ class EventDriven(Engine):
         queue = self._queue
         pop_before = queue.pop_before
         predict = self._predict
-        disc = self._disc
+        disc, unpack, pack = self._disc, _RECORD.unpack_from, _RECORD.pack_into
         count, mass, moving = self._count, self._mass, self._moving
         cell, cells, grid = self._cell, self._cells, self.grid
         nx, ny = grid.nx, grid.ny
@@ -864,11 +861,11 @@ class EventDriven(Engine):
                     predict(i, t, -1)
                     continue
                 # Advance the two discs to the contact.
-                xi, yi, vxi, vyi, ti, ri = disc[i]
+                xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
                 dt = t - ti
                 xi += vxi * dt
                 yi += vyi * dt
-                xj, yj, vxj, vyj, tj, rj = disc[j]
+                xj, yj, vxj, vyj, tj, rj = unpack(disc, j * _RECORD_BYTES)
                 dt = t - tj
                 xj += vxj * dt
                 yj += vyj * dt
@@ -880,8 +877,8 @@ class EventDriven(Engine):
                 if overlap > max_overlap:
                     max_overlap = overlap
                 uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mass[i], mass[j])
-                disc[i] = (xi, yi, uxi, uyi, t, ri)
-                disc[j] = (xj, yj, uxj, uyj, t, rj)
+                pack(disc, i * _RECORD_BYTES, xi, yi, uxi, uyi, t, ri)
+                pack(disc, j * _RECORD_BYTES, xj, yj, uxj, uyj, t, rj)
                 virial -= mass[i] * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
                 count[i] += 1
                 n_coll += 1
@@ -899,7 +896,7 @@ class EventDriven(Engine):
                         max_queue = size
                 last = (t + epoch, _COLLISION, i, j)
             elif kind == _WALL:
-                xi, yi, vxi, vyi, ti, ri = disc[i]
+                xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
                 dt = t - ti
                 xi += vxi * dt
                 yi += vyi * dt
@@ -907,7 +904,7 @@ class EventDriven(Engine):
                     vxi = -vxi
                 else:
                     vyi = -vyi
-                disc[i] = (xi, yi, vxi, vyi, t, ri)
+                pack(disc, i * _RECORD_BYTES, xi, yi, vxi, vyi, t, ri)
                 count[i] += 1
                 n_wall += 1
                 done += 1
@@ -916,12 +913,12 @@ class EventDriven(Engine):
                 predict(i, t, -1)
                 last = (t + epoch, _WALL, i, -1)
             elif kind == _SEGMENT:
-                xi, yi, vxi, vyi, ti, ri = disc[i]
+                xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
                 dt = t - ti
                 xi += vxi * dt
                 yi += vyi * dt
                 vxi, vyi = reflect_off_segment(xi, yi, vxi, vyi, *segment_ends[other])
-                disc[i] = (xi, yi, vxi, vyi, t, ri)
+                pack(disc, i * _RECORD_BYTES, xi, yi, vxi, vyi, t, ri)
                 count[i] += 1
                 n_wall += 1
                 done += 1
@@ -942,26 +939,26 @@ class EventDriven(Engine):
                     cx += 1
                     if cx == nx:
                         cx = 0
-                        xi, yi, vxi, vyi, ti, ri = disc[i]
-                        disc[i] = (xi - width, yi, vxi, vyi, ti, ri)
+                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
+                        pack(disc, i * _RECORD_BYTES, xi - width, yi, vxi, vyi, ti, ri)
                 elif other == _MINUS_X:
                     cx -= 1
                     if cx < 0:
                         cx = nx - 1
-                        xi, yi, vxi, vyi, ti, ri = disc[i]
-                        disc[i] = (xi + width, yi, vxi, vyi, ti, ri)
+                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
+                        pack(disc, i * _RECORD_BYTES, xi + width, yi, vxi, vyi, ti, ri)
                 elif other == _PLUS_Y:
                     cy += 1
                     if cy == ny:
                         cy = 0
-                        xi, yi, vxi, vyi, ti, ri = disc[i]
-                        disc[i] = (xi, yi - height, vxi, vyi, ti, ri)
+                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
+                        pack(disc, i * _RECORD_BYTES, xi, yi - height, vxi, vyi, ti, ri)
                 else:
                     cy -= 1
                     if cy < 0:
                         cy = ny - 1
-                        xi, yi, vxi, vyi, ti, ri = disc[i]
-                        disc[i] = (xi, yi + height, vxi, vyi, ti, ri)
+                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
+                        pack(disc, i * _RECORD_BYTES, xi, yi + height, vxi, vyi, ti, ri)
                 c = cx * ny + cy
                 cell[i] = c
                 cells[c] += (i,)
@@ -995,7 +992,8 @@ class EventDriven(Engine):
         it goes on. O(N log N); the hot loop calls it every ``_rebase_every``
         physical events, a count that does not depend on how a run is split.
         """
-        self._disc[:] = [(x, y, vx, vy, t - shift, r) for x, y, vx, vy, t, r in self._disc]
+        records = np.frombuffer(self._disc, dtype=np.float64).reshape(-1, 6)  # a view: edits in place
+        records[:, 4] -= shift
         self._kept_time[:] = [t - shift for t in self._kept_time]
         self._queue.shift_times(shift)
         self._epoch += shift
@@ -1028,6 +1026,11 @@ class EventDriven(Engine):
                 assert inside_x and inside_y, f"disc {i} at {pos[i]} is not in its cell {c}"
             t_pending, payload = self._queue.pending(i)
             assert t_pending >= self.time - self._epoch - 1e-12 * max(1.0, self.time)
-            if self._moving[i] and (self._disc[i][2] or self._disc[i][3]):
+            if self._moving[i] and (self._records()[i, 2] or self._records()[i, 3]):
                 assert payload is not None or t_pending == INF
         check_fits(Discs(pos, self.velocities, self.discs.radii, self.discs.masses), self.box)
+
+
+def _pack_records(x, y, vx, vy, t_ref, radius) -> bytearray:
+    """The state buffer of per-disc records from ``(N,)`` arrays, one per field."""
+    return bytearray(np.column_stack([x, y, vx, vy, t_ref, radius]).astype(np.float64).tobytes())

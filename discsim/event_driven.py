@@ -39,7 +39,7 @@ from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, EventLog, stream_header
 from discsim.grid import CellGrid, check_fits, check_scene
 from discsim.io import RecordWriter, read_state, write_state
 from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
-from discsim.queue import EventQueue, HeapEventQueue
+from discsim.queue import CalendarEventQueue, EventQueue, HeapEventQueue
 from discsim.state import Box, Discs, Segment
 
 __all__ = ["EventDriven"]
@@ -56,7 +56,7 @@ _REBASE_EVENTS = 1 << 18
 # Directions of a cell crossing.
 _PLUS_X, _MINUS_X, _PLUS_Y, _MINUS_Y = 0, 1, 2, 3
 
-_QUEUES = {"sorted": EventQueue, "heap": HeapEventQueue}
+_QUEUES = {"calendar": CalendarEventQueue, "sorted": EventQueue, "heap": HeapEventQueue}
 
 
 class EventDriven(Engine):
@@ -67,8 +67,12 @@ class EventDriven(Engine):
         box: the box (reflecting walls or periodic).
         record: keep the event log (needed by ``events`` and ``trajectory``);
             switch off for long runs so memory stays flat.
-        queue: ``"sorted"`` (a ``sortedcontainers.SortedList``, the default) or
-            ``"heap"`` (``heapq`` with lazy deletion).
+        queue: the event queue, all three giving the same events bit for bit:
+            ``"calendar"`` (the default: the near-future events in a
+            ``sortedcontainers.SortedList``, later ones appended to time bins,
+            O(1) per event; :class:`~discsim.queue.CalendarEventQueue`),
+            ``"sorted"`` (every event in one ``SortedList``) or ``"heap"``
+            (``heapq`` with lazy deletion).
         cell_size: side of the grid cells; default the largest disc diameter,
             grown where needed so that there are at most ``4 N + 9`` cells.
             Never below the largest diameter.
@@ -105,7 +109,7 @@ class EventDriven(Engine):
         box: Box,
         *,
         record: bool = True,
-        queue: str = "sorted",
+        queue: str = "calendar",
         cell_size: float | None = None,
         segments=(),
         pass_through=(),

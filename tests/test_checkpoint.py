@@ -58,7 +58,7 @@ def _state_bytes(sim) -> bytes:
 
 
 # --- save / load -----------------------------------------------------------------------
-@pytest.mark.parametrize("queue", ["sorted", "heap"])
+@pytest.mark.parametrize("queue", ["calendar", "sorted", "heap"])
 @pytest.mark.parametrize("periodic", [True, False])
 def test_save_load_continues_bit_for_bit(tmp_path, queue, periodic):
     discs, box = ds.random_gas(150, 0.5, periodic=periodic, seed=3)

@@ -54,9 +54,10 @@ def test_mixed_radii_masses_and_obstacles_follow_the_oracle(periodic):
     _lockstep_times(ds.EventDriven(discs, ds.Box(side, side, periodic=periodic)), 300)
 
 
-def test_dense_gas_follows_the_oracle_with_the_heap_queue():
+@pytest.mark.parametrize("queue", ["heap", "sorted"])
+def test_dense_gas_follows_the_oracle_with_the_other_queues(queue):
     discs, box = ds.random_gas(36, 0.6, periodic=True, seed=3)
-    _lockstep_times(ds.EventDriven(discs, box, queue="heap"), 300)
+    _lockstep_times(ds.EventDriven(discs, box, queue=queue), 300)
 
 
 def test_large_cells_follow_the_oracle():

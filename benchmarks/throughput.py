@@ -1,10 +1,17 @@
 """Throughput of discsim's event-driven engine (PIC): collisions/s, events/s, queue size, memory.
 
-Run ``python benchmarks/throughput.py`` (a few minutes) or ``--quick`` (seconds).
+Run ``python benchmarks/throughput.py`` (about 15 minutes in full, more on a loaded machine) or ``--quick`` (seconds).
 For each N and packing fraction, a seeded periodic :func:`discsim.random_gas`
 is built, equilibrated for a few collisions per disc (a dense start is a
 crystal and must melt), then timed over a fixed number of collisions. Every
 measurement is the median of several runs, each from its own seed.
+
+The main PIC section times the engine's default event queue (the ``queue``
+column names it: ``calendar`` when this was written). The queue section runs
+``calendar``, ``sorted`` and ``heap`` side by side at packing fraction 0.3,
+runs interleaved (seed by seed, queue by queue) so that drift in the machine's
+load hits all three alike; the three give bit-identical simulations, so they
+time the same collisions.
 
 Definitions, as printed and written to CSV:
 
@@ -14,8 +21,14 @@ Definitions, as printed and written to CSV:
   machine inflate less (the header prints the load average).
 * ``events/s``: every event the engine pops in that segment (collisions, wall
   hits, cell crossings and stale events) per second.
-* ``max queue``: ``sim.max_queue``, the largest number of pending events seen
-  over the whole run (construction included).
+* ``max queue``: ``sim.max_queue``, the largest number of pending (live)
+  events seen over the whole run (construction included); the largest over the runs.
+* ``storage`` (queue section): entries the queue holds at the end of the timed
+  segment, dead ones included (the heap and the calendar keep replaced events
+  until they are popped or compacted; ``sorted`` holds live ones only). A
+  snapshot, the largest over the runs; ``storage/N`` divides it by N.
+* ``vs sorted``: a queue's median collisions/s over that of ``sorted`` at the
+  same N (``vs sorted (CPU)`` the same with CPU seconds).
 * ``peak MB``: ``tracemalloc`` peak of Python and numpy allocations while building
   the gas and the engine and equilibrating it, in a separate untimed pass
   (tracemalloc slows Python down, so it never runs during timing).
@@ -41,9 +54,21 @@ PIT (fixed-step) sections, on the same kind of equilibrated periodic gas:
   with :func:`discsim.compare` when that file is missing; the output says
   which. ``crossover step``: the step at which PIT would cost as much as PIC.
 
+Targets: the end of the PIC section prints the engine issue's targets
+against the measured medians, each marked ``met``, ``not met`` or ``not
+measured`` (the point was not run, e.g. in ``--quick`` mode), and writes them
+to ``throughput_targets.csv`` (:data:`TARGETS`): collisions/s at N = 10^4,
+packing 0.3, at least 40,000; collisions/s at N = 10^3 over those at N = 10^5
+(packing 0.3 and 0.7) at most 2; fresh-process peak RSS at N = 10^5 (the
+larger over the packing fractions) under 300 MB. Figures only: nothing here
+asserts a time.
+
 Sections are functions listed in :data:`SECTIONS`. Output: ``throughput.csv``,
-``throughput_queue.csv``, ``throughput_pit.csv``, ``throughput_crossover.csv``,
-``throughput.png`` and ``throughput_pit.png`` in ``--results``.
+``throughput_targets.csv``, ``throughput_queue.csv``, ``throughput_pit.csv``,
+``throughput_crossover.csv``, ``throughput.png`` (collisions/s against N, the
+default queue per packing fraction with error bars and the three queues at
+0.3 dashed/dotted; pending events and queue storage against N) and
+``throughput_pit.png`` in ``--results``.
 """
 
 from __future__ import annotations
@@ -51,7 +76,9 @@ from __future__ import annotations
 import csv
 import dataclasses
 import gc
+import inspect
 import math
+import operator
 import subprocess
 import sys
 import tracemalloc
@@ -85,7 +112,7 @@ class Config:
         equilibrate_per_disc: untimed collisions per disc before timing.
         timed_per_disc, timed_min: the timed segment has
             ``max(timed_per_disc * N, timed_min)`` collisions.
-        queue_sizes, queue_fraction: where ``sorted`` and ``heap`` queues run side by side.
+        queue_sizes, queue_fraction: where the three event queues (:data:`QUEUES`) run side by side.
         pit_sizes: N of the fixed-step frames/s section (packing fraction 0.3).
         pit_all_pairs_max: largest N at which the all-pairs broad phase runs.
         pit_frames, pit_all_pairs_frames: timed frames per run in that section
@@ -153,22 +180,28 @@ QUICK = Config(
 
 _EVENT_KINDS = ("collisions", "wall_hits", "cell_crossings", "stale")
 
+#: The event queues of :class:`discsim.EventDriven`, compared side by side by :func:`queue_section`.
+QUEUES = ("calendar", "sorted", "heap")
+#: The queue the engine uses when none is given (what the main PIC section times).
+DEFAULT_QUEUE = inspect.signature(ds.EventDriven).parameters["queue"].default
+
 
 # --- one measurement -------------------------------------------------------------------
-def measure_pic(n: int, packing_fraction: float, queue: str, seed: int, config: Config) -> dict:
+def measure_pic(n: int, packing_fraction: float, queue: str | None, seed: int, config: Config) -> dict:
     """Build, equilibrate and time one event-driven run.
 
     Args:
         n: number of discs.
         packing_fraction: of the periodic random gas.
-        queue: ``"sorted"`` or ``"heap"``.
+        queue: one of :data:`QUEUES`, or None for the engine's default.
         seed: seed of :func:`discsim.random_gas`.
         config: run lengths.
 
     Returns:
-        A dict with ``setup_s`` (gas and engine construction), ``seconds`` and
-        ``cpu_seconds`` (the timed segment, wall-clock and CPU), ``collisions`` and ``events`` in it, ``max_queue``,
-        ``queue_size`` and ``simulated_time`` of the segment.
+        A dict with ``queue`` (the queue used), ``setup_s`` (gas and engine
+        construction), ``seconds`` and ``cpu_seconds`` (the timed segment,
+        wall-clock and CPU), ``collisions`` and ``events`` in it, ``max_queue``,
+        ``queue_size`` and ``storage`` at its end, and ``simulated_time`` of the segment.
     """
     gc.collect()
     setup = timed(lambda: _build(n, packing_fraction, seed, queue))
@@ -178,6 +211,7 @@ def measure_pic(n: int, packing_fraction: float, queue: str, seed: int, config: 
     run = timed(lambda: sim.run(events=config.timed_collisions(n)))
     delta = {k: sim.counts[k] - before[k] for k in _EVENT_KINDS}
     return {
+        "queue": sim.queue_kind,
         "setup_s": setup.wall,
         "seconds": run.wall,
         "cpu_seconds": run.cpu,
@@ -185,22 +219,27 @@ def measure_pic(n: int, packing_fraction: float, queue: str, seed: int, config: 
         "events": sum(delta.values()),
         "max_queue": sim.max_queue,
         "queue_size": sim.queue_size,
+        # EventDriven has no public view of the queue's storage (entries held, dead ones
+        # included; ``queue_size`` counts live events only), so it is read from the queue.
+        "storage": sim._queue.storage(),
         "simulated_time": sim.time - t_before,
     }
 
 
-def _build(n: int, packing_fraction: float, seed: int, queue: str) -> ds.EventDriven:
+def _build(n: int, packing_fraction: float, seed: int, queue: str | None = None) -> ds.EventDriven:
+    """A periodic random gas and its engine; ``queue=None`` leaves the engine's default."""
     discs, box = ds.random_gas(n, packing_fraction, periodic=True, seed=seed)
-    return ds.EventDriven(discs, box, record=False, queue=queue)
+    options = {} if queue is None else {"queue": queue}
+    return ds.EventDriven(discs, box, record=False, **options)
 
 
-def summarise(runs: list[dict], n: int, packing_fraction: float, queue: str) -> dict:
-    """One table row from repeated runs of the same point (medians, and the spread of rates)."""
+def summarise(runs: list[dict], n: int, packing_fraction: float) -> dict:
+    """One table row from repeated runs of the same point and queue (medians, and the spread of rates)."""
     rates = [r["collisions"] / r["seconds"] for r in runs]
     return {
         "n": n,
         "packing_fraction": packing_fraction,
-        "queue": queue,
+        "queue": runs[0]["queue"],
         "repeats": len(runs),
         "timed_collisions": runs[0]["collisions"],
         "collisions_per_s": median(rates),
@@ -212,15 +251,17 @@ def summarise(runs: list[dict], n: int, packing_fraction: float, queue: str) -> 
         "setup_s": median([r["setup_s"] for r in runs]),
         "max_queue": max(r["max_queue"] for r in runs),
         "max_queue_per_n": max(r["max_queue"] for r in runs) / n,
+        "storage": max(r["storage"] for r in runs),
+        "storage_per_n": max(r["storage"] for r in runs) / n,
     }
 
 
 def peak_memory_mb(n: int, packing_fraction: float, config: Config) -> float:
-    """Tracemalloc peak (MB) of building an ``n``-disc gas and engine and equilibrating it."""
+    """Tracemalloc peak (MB) of building an ``n``-disc gas and engine (default queue) and equilibrating it."""
     gc.collect()
     tracemalloc.start()
     try:
-        sim = _build(n, packing_fraction, 0, "sorted")
+        sim = _build(n, packing_fraction, 0)
         sim.run(events=max(1, round(config.equilibrate_per_disc * n)))
         _, peak = tracemalloc.get_traced_memory()
     finally:
@@ -246,6 +287,8 @@ print(after_import, peak_resident_mb())
 def peak_rss_mb(n: int, packing_fraction: float, config: Config) -> tuple[float, float]:
     """Peak resident MB of a fresh process after importing discsim, and after building and equilibrating.
 
+    The engine uses its default queue.
+
     Returns NaNs where the probe fails.
     """
     events = max(1, round(config.equilibrate_per_disc * n))
@@ -263,6 +306,7 @@ def peak_rss_mb(n: int, packing_fraction: float, config: Config) -> tuple[float,
 THROUGHPUT_COLUMNS = [
     Column("n", "N", ","),
     Column("packing_fraction", "phi", ".2f"),
+    Column("queue", "queue"),
     Column("collisions_per_s", "coll/s", ",.0f"),
     Column("collisions_per_s_min", "min", ",.0f"),
     Column("collisions_per_s_max", "max", ",.0f"),
@@ -279,41 +323,104 @@ THROUGHPUT_COLUMNS = [
 
 
 def pic_throughput_section(config: Config, results: Path) -> list[dict]:
-    """Collisions/s, events/s, max queue and peak memory against N and packing fraction (sorted queue)."""
+    """Collisions/s, events/s, max queue and peak memory against N and packing fraction (default queue).
+
+    Ends with the engine issue's targets (:func:`target_rows`), printed and
+    written to ``throughput_targets.csv``.
+    """
     rows = []
     for n in config.sizes:
         for phi in config.fractions:
             announce(f"  PIC N={n:,} phi={phi}: {config.repeats} run(s) of {config.timed_collisions(n):,} collisions")
-            runs = [measure_pic(n, phi, "sorted", seed, config) for seed in range(config.repeats)]
-            row = summarise(runs, n, phi, "sorted")
+            runs = [measure_pic(n, phi, None, seed, config) for seed in range(config.repeats)]
+            row = summarise(runs, n, phi)
             if config.memory:
                 row["peak_mb"] = peak_memory_mb(n, phi, config)
                 row["rss_import_mb"], row["rss_mb"] = peak_rss_mb(n, phi, config)
             rows.append(row)
     print(format_table(rows, THROUGHPUT_COLUMNS))
-    print(_targets(rows))
-    keys = [c.key for c in THROUGHPUT_COLUMNS] + ["rss_import_mb", "queue", "repeats"]
+    keys = [c.key for c in THROUGHPUT_COLUMNS] + ["rss_import_mb", "repeats"]
     write_csv(results / "throughput.csv", rows, keys)
+    targets = target_rows(rows)
+    print(format_targets(targets))
+    write_csv(results / "throughput_targets.csv", targets, TARGET_KEYS)
     return rows
 
 
-def _targets(rows: list[dict]) -> str:
-    """Lines comparing the rows with issue 2's speed targets (printed, never asserted)."""
+# --- the engine issue's targets ----------------------------------------------------------
+#: ``(target, description, comparison, limit, unit)`` of each target, in print order.
+TARGETS = (
+    ("collisions_per_s_n1e4_phi0.3", "collisions/s at N=10^4, phi=0.3", ">=", 40_000.0, "coll/s"),
+    ("slowdown_n1e3_over_n1e5_phi0.3", "coll/s at N=10^3 over coll/s at N=10^5, phi=0.3", "<=", 2.0, "x"),
+    ("slowdown_n1e3_over_n1e5_phi0.7", "coll/s at N=10^3 over coll/s at N=10^5, phi=0.7", "<=", 2.0, "x"),
+    ("peak_rss_mb_n1e5", "peak RSS of a fresh process at N=10^5 (largest over phi)", "<", 300.0, "MB"),
+)
+#: Columns of ``throughput_targets.csv``.
+TARGET_KEYS = ["target", "description", "measured", "comparison", "limit", "unit", "status", "queue", "note"]
+_FORMATS = {"coll/s": ",.0f", "x": ".2f", "MB": ".0f"}
+_COMPARE = {">=": operator.ge, "<=": operator.le, "<": operator.lt}
+
+
+def target_rows(rows: list[dict]) -> list[dict]:
+    """The engine issue's targets against the medians of :func:`pic_throughput_section` rows.
+
+    One row per entry of :data:`TARGETS`, always; ``measured`` is NaN and
+    ``status`` ``"not measured"`` where a point needed was not run (as in
+    ``--quick`` mode), else ``status`` is ``"met"`` or ``"not met"``.
+    Figures only: the caller prints them, nothing asserts them.
+    """
     by_point = {(r["n"], r["packing_fraction"]): r for r in rows}
-    lines = []
-    if (10_000, 0.3) in by_point:
-        rate = by_point[10_000, 0.3]["collisions_per_s"]
-        lines.append(f"target >= 40,000 coll/s at N=10^4, phi=0.3: measured {rate:,.0f}")
-    for phi in sorted({p for _, p in by_point}):
-        if (1_000, phi) in by_point and (100_000, phi) in by_point:
-            slowdown = by_point[1_000, phi]["collisions_per_s"] / by_point[100_000, phi]["collisions_per_s"]
-            lines.append(f"target N=10^5 at most 2x slower than N=10^3 (phi={phi}): {slowdown:.2f}x slower")
-        if (100_000, phi) in by_point and "peak_mb" in by_point[100_000, phi]:
-            row = by_point[100_000, phi]
-            lines.append(
-                f"target peak < 300 MB at N=10^5 (phi={phi}): tracemalloc {row['peak_mb']:.1f} MB, "
-                f"fresh-process RSS {row['rss_mb']:.0f} MB ({row['rss_import_mb']:.0f} MB of it after imports)"
-            )
+
+    def rate(n: int, phi: float) -> float:
+        return by_point[n, phi]["collisions_per_s"] if (n, phi) in by_point else math.nan
+
+    def slowdown(phi: float) -> float:
+        large = rate(100_000, phi)
+        return rate(1_000, phi) / large if large > 0 else math.nan
+
+    large = [r for (n, _), r in sorted(by_point.items()) if n == 100_000 and not math.isnan(r.get("rss_mb", math.nan))]
+    worst = max(large, key=lambda r: r["rss_mb"], default=None)
+    measured = [rate(10_000, 0.3), slowdown(0.3), slowdown(0.7), worst["rss_mb"] if worst else math.nan]
+    notes = ["", "", "", ""]
+    if worst:
+        notes[3] = (
+            f"phi={worst['packing_fraction']:g}; {worst['rss_import_mb']:.0f} MB of it after imports; "
+            f"tracemalloc peak {worst.get('peak_mb', math.nan):.1f} MB"
+        )
+    queues = sorted({r["queue"] for r in rows})
+    out = []
+    for (key, description, comparison, limit, unit), value, note in zip(TARGETS, measured, notes, strict=True):
+        if math.isnan(value):
+            status = "not measured"
+        else:
+            status = "met" if _COMPARE[comparison](value, limit) else "not met"
+        out.append(
+            {
+                "target": key,
+                "description": description,
+                "measured": value,
+                "comparison": comparison,
+                "limit": limit,
+                "unit": unit,
+                "status": status,
+                "queue": "/".join(queues),
+                "note": note,
+            }
+        )
+    return out
+
+
+def format_targets(targets: list[dict]) -> str:
+    """The printed targets block: one line per target, measured against the limit, met or not."""
+    queue = targets[0]["queue"] if targets else ""
+    lines = [f"targets of the engine issue (medians above, queue {queue}; figures, not assertions):"]
+    width = max((len(t["description"]) for t in targets), default=0)
+    for t in targets:
+        fmt = _FORMATS.get(t["unit"], ".3g")
+        value = "-" if math.isnan(t["measured"]) else format(t["measured"], fmt)
+        text = f"  {t['description']:<{width}}  {value:>8} {t['unit']:<6} (target {t['comparison']} "
+        text += f"{format(t['limit'], fmt)}): {t['status']}"
+        lines.append(text + (f"  [{t['note']}]" if t["note"] else ""))
     return "\n".join(lines)
 
 
@@ -328,26 +435,39 @@ QUEUE_COLUMNS = [
     Column("events_per_s", "events/s", ",.0f"),
     Column("seconds", "run s", ".2f"),
     Column("max_queue", "max queue", ","),
+    Column("storage", "storage", ","),
+    Column("storage_per_n", "storage/N", ".3f"),
     Column("speedup_vs_sorted", "vs sorted", ".2f"),
     Column("cpu_speedup_vs_sorted", "vs sorted (CPU)", ".2f"),
 ]
 
 
 def queue_section(config: Config, results: Path) -> list[dict]:
-    """The ``sorted`` and ``heap`` event queues side by side, runs interleaved so that drift hits both."""
+    """The three event queues (:data:`QUEUES`) side by side, runs interleaved so that drift hits all alike.
+
+    For each seed every queue runs once, the order rotated from seed to seed
+    (with three repeats each queue goes first once). The queues give
+    bit-identical simulations; a line is printed if a seed's simulated time
+    differs between them (it should not).
+    """
     rows = []
+    phi = config.queue_fraction
     for n in config.queue_sizes:
-        phi = config.queue_fraction
-        announce(f"  queues N={n:,} phi={phi}: sorted and heap, {config.repeats} run(s) each, interleaved")
-        runs = {"sorted": [], "heap": []}
+        announce(f"  queues N={n:,} phi={phi}: {', '.join(QUEUES)}, {config.repeats} run(s) each, interleaved")
+        runs = {q: [] for q in QUEUES}
         for seed in range(config.repeats):
-            for queue in runs:
+            shift = seed % len(QUEUES)
+            for queue in QUEUES[shift:] + QUEUES[:shift]:
                 runs[queue].append(measure_pic(n, phi, queue, seed, config))
-        pair = [summarise(runs[q], n, phi, q) for q in runs]
-        for row in pair:
-            row["speedup_vs_sorted"] = row["collisions_per_s"] / pair[0]["collisions_per_s"]
-            row["cpu_speedup_vs_sorted"] = row["collisions_per_cpu_s"] / pair[0]["collisions_per_cpu_s"]
-        rows += pair
+            times = {q: runs[q][-1]["simulated_time"] for q in QUEUES}
+            if len(set(times.values())) > 1:
+                print(f"warning: N={n:,} seed {seed}: the queues simulated different times {times}")
+        group = [summarise(runs[q], n, phi) for q in QUEUES]
+        sorted_row = group[QUEUES.index("sorted")]
+        for row in group:
+            row["speedup_vs_sorted"] = row["collisions_per_s"] / sorted_row["collisions_per_s"]
+            row["cpu_speedup_vs_sorted"] = row["collisions_per_cpu_s"] / sorted_row["collisions_per_cpu_s"]
+        rows += group
     print(format_table(rows, QUEUE_COLUMNS))
     write_csv(results / "throughput_queue.csv", rows, [c.key for c in QUEUE_COLUMNS] + ["repeats", "timed_collisions"])
     return rows
@@ -614,8 +734,18 @@ def plot_pit(pit_rows: list[dict], cost_rows: list[dict], path: Path) -> Path:
     return path
 
 
+#: Line style and marker of each queue in :func:`plot`.
+QUEUE_STYLES = {"calendar": ("--", "^"), "sorted": (":", "s"), "heap": ("-.", "D")}
+
+
 def plot(throughput_rows: list[dict], queue_rows: list[dict], path: Path) -> Path:
-    """Two panels: collisions/s against N (each phi; heap queue dashed), and max queue size against N."""
+    """Two panels against N: collisions/s, and pending events and queue storage.
+
+    Left: the default queue for each phi (solid, min-max error bars), and the
+    three queues of :func:`queue_section` (black, dashed/dotted). Right: the
+    largest number of pending events for each phi, and each queue's storage
+    (dead entries included) in the same styles.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -634,21 +764,24 @@ def plot(throughput_rows: list[dict], queue_rows: list[dict], path: Path) -> Pat
             ],
             marker="o",
             capsize=3,
-            label=f"phi={phi:g}, sorted queue",
+            label=f"phi={phi:g}, {rows[0]['queue']} (default)",
         )
-        ax_queue.plot(ns, [r["max_queue"] for r in rows], marker="o", label=f"max queue, phi={phi:g}")
-    heap = [r for r in queue_rows if r["queue"] == "heap"]
-    if heap:
-        phi = heap[0]["packing_fraction"]
-        ax_rate.plot(
-            [r["n"] for r in heap], [r["collisions_per_s"] for r in heap], "k--", marker="s", label=f"phi={phi:g}, heap"
-        )
-    ns = sorted({r["n"] for r in throughput_rows})
-    ax_queue.plot(ns, ns, "k:", label="N")
+        ax_queue.plot(ns, [r["max_queue"] for r in rows], marker="o", label=f"max pending, phi={phi:g}")
+    for queue, (style, marker) in QUEUE_STYLES.items():
+        rows = [r for r in queue_rows if r["queue"] == queue]
+        if not rows:
+            continue
+        ns, phi = [r["n"] for r in rows], rows[0]["packing_fraction"]
+        common = {"color": "k", "marker": marker, "markerfacecolor": "none"}
+        label = f"phi={phi:g}, {queue}, side by side"
+        ax_rate.plot(ns, [r["collisions_per_s"] for r in rows], style, label=label, **common)
+        ax_queue.plot(ns, [r["storage"] for r in rows], style, label=f"storage, {queue}, phi={phi:g}", **common)
+    ns = sorted({r["n"] for r in throughput_rows} | {r["n"] for r in queue_rows})
+    ax_queue.plot(ns, ns, color="0.6", linewidth=1, label="N")
     ax_rate.set(xscale="log", yscale="log", xlabel="N discs", ylabel="collisions / s (median)")
     ax_rate.set_title("discsim EventDriven throughput")
-    ax_queue.set(xscale="log", yscale="log", xlabel="N discs", ylabel="events pending")
-    ax_queue.set_title("largest event queue")
+    ax_queue.set(xscale="log", yscale="log", xlabel="N discs", ylabel="queue entries")
+    ax_queue.set_title("event queue: most pending, storage at the end")
     for ax in (ax_rate, ax_queue):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
@@ -659,8 +792,8 @@ def plot(throughput_rows: list[dict], queue_rows: list[dict], path: Path) -> Pat
 
 #: The sections in run order: (title, function(config, results) -> rows).
 SECTIONS = [
-    ("PIC throughput (periodic random gas, sorted queue)", pic_throughput_section),
-    ("PIC event queue: sorted against heap", queue_section),
+    (f"PIC throughput (periodic random gas, default queue: {DEFAULT_QUEUE})", pic_throughput_section),
+    (f"PIC event queues side by side: {', '.join(QUEUES)}", queue_section),
     ("PIT throughput: frames/s and pair tests/s, cell grid against all pairs", pit_throughput_section),
     ("PIC against PIT: seconds per unit simulated time at 1% missed", pic_against_pit_section),
 ]
@@ -684,7 +817,13 @@ def main(argv=None) -> int:
     )
     print(f"\nthis script's peak resident memory: {peak_resident_mb():.0f} MB")
     print(f"load average at the end: {load_average():.2f}")
-    written = ["throughput.csv", "throughput_queue.csv", "throughput_pit.csv", "throughput_crossover.csv"]
+    written = [
+        "throughput.csv",
+        "throughput_targets.csv",
+        "throughput_queue.csv",
+        "throughput_pit.csv",
+        "throughput_crossover.csv",
+    ]
     print(f"wrote {', '.join(str(args.results / f) for f in written)}, {png}, {pit_png}")
     return 0
 

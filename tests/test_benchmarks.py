@@ -6,6 +6,7 @@ No test here asserts a speed: timings belong to the scripts' output, not to pass
 import csv
 import doctest
 import importlib.util
+import inspect
 import math
 import os
 import subprocess
@@ -50,20 +51,64 @@ def _read_csv(path: Path) -> list[dict]:
         return list(csv.DictReader(handle))
 
 
+@pytest.fixture(scope="module")
+def throughput():
+    """benchmarks/throughput.py as a module (it imports ``benchutils`` from its own folder)."""
+    spec = importlib.util.spec_from_file_location("throughput", BENCHMARKS / "throughput.py")
+    module = importlib.util.module_from_spec(spec)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(BENCHMARKS))
+        patch.setitem(sys.modules, "throughput", module)  # its dataclasses look their module up there
+        spec.loader.exec_module(module)
+        yield module
+
+
+_TARGET_KEYS = [
+    "collisions_per_s_n1e4_phi0.3",
+    "slowdown_n1e3_over_n1e5_phi0.3",
+    "slowdown_n1e3_over_n1e5_phi0.7",
+    "peak_rss_mb_n1e5",
+]
+
+
 @pytest.mark.slow
 def test_throughput_quick_writes_its_csv_and_plot(tmp_path):
     done = _run_quick("throughput.py", tmp_path)
     assert done.returncode == 0, done.stderr
+    default_queue = inspect.signature(ds.EventDriven).parameters["queue"].default
     rows = _read_csv(tmp_path / "throughput.csv")
     assert len(rows) == 4  # 2 sizes x 2 packing fractions
     for row in rows:
+        assert row["queue"] == default_queue  # the main section times the engine's default queue
         assert float(row["collisions_per_s"]) > 0
         assert 0 < int(row["max_queue"]) <= int(row["n"])  # one pending event per disc at most
         assert float(row["peak_mb"]) > 0
     queues = _read_csv(tmp_path / "throughput_queue.csv")
-    assert sorted(r["queue"] for r in queues) == ["heap", "sorted"]
+    assert [r["queue"] for r in queues] == ["calendar", "sorted", "heap"]  # N = 400 only
+    for row in queues:
+        n = int(row["n"])
+        assert float(row["collisions_per_s"]) > 0
+        assert 0 < int(row["max_queue"]) <= n
+        assert 0 < int(row["storage"]) <= 3 * n + 64  # dead entries included; the calendar's bound
+        assert float(row["speedup_vs_sorted"]) > 0
+    by_queue = {r["queue"]: r for r in queues}
+    assert float(by_queue["sorted"]["speedup_vs_sorted"]) == 1.0
+    assert int(by_queue["sorted"]["storage"]) <= int(by_queue["sorted"]["n"])  # no dead entries
+    assert len({r["timed_collisions"] for r in queues}) == 1
+    # The targets need N = 10^3..10^5, which quick mode does not run: every row says so.
+    targets = _read_csv(tmp_path / "throughput_targets.csv")
+    assert [r["target"] for r in targets] == _TARGET_KEYS
+    assert [(r["comparison"], float(r["limit"])) for r in targets] == [
+        (">=", 40_000.0),
+        ("<=", 2.0),
+        ("<=", 2.0),
+        ("<", 300.0),
+    ]
+    assert all(r["status"] == "not measured" and math.isnan(float(r["measured"])) for r in targets)
+    assert all(r["queue"] == default_queue for r in targets)
     assert (tmp_path / "throughput.png").stat().st_size > 0
-    assert "coll/s" in done.stdout
+    assert "coll/s" in done.stdout and "vs sorted" in done.stdout and "storage" in done.stdout
+    assert "targets of the engine issue" in done.stdout and "not measured" in done.stdout
     pit = _read_csv(tmp_path / "throughput_pit.csv")
     assert {r["broad_phase"] for r in pit} == {"grid", "all-pairs"}
     assert all(float(r["frames_per_s"]) > 0 and float(r["pair_tests_per_s"]) > 0 for r in pit)
@@ -86,6 +131,44 @@ def test_peers_quick_writes_its_csv_and_plot(tmp_path):
     fixed = [r for r in pit if r["engine"] == "fixed_step"]
     assert fixed and float(fixed[0]["seconds_per_frame"]) > 0
     assert int(fixed[0]["matched"]) + int(fixed[0]["missed"]) == int(fixed[0]["truth"])
+
+
+def _point(n: int, phi: float, rate: float, rss: float = math.nan) -> dict:
+    return {
+        "n": n,
+        "packing_fraction": phi,
+        "queue": "calendar",
+        "collisions_per_s": rate,
+        "rss_mb": rss,
+        "rss_import_mb": 60.0,
+        "peak_mb": 150.0,
+    }
+
+
+def test_targets_from_the_medians(throughput):
+    rows = [
+        _point(1_000, 0.3, 70_000.0),
+        _point(10_000, 0.3, 40_000.0),  # exactly the target: met
+        _point(100_000, 0.3, 20_000.0, rss=250.0),  # 3.5x slower: not met
+        _point(1_000, 0.7, 30_000.0),
+        _point(100_000, 0.7, 20_000.0, rss=320.0),  # 1.5x slower: met; the larger RSS counts
+    ]
+    targets = {t["target"]: t for t in throughput.target_rows(rows)}
+    assert list(targets) == _TARGET_KEYS
+    assert targets["collisions_per_s_n1e4_phi0.3"]["measured"] == 40_000.0
+    assert targets["slowdown_n1e3_over_n1e5_phi0.3"]["measured"] == pytest.approx(3.5)
+    assert targets["slowdown_n1e3_over_n1e5_phi0.7"]["measured"] == pytest.approx(1.5)
+    assert targets["peak_rss_mb_n1e5"]["measured"] == 320.0
+    assert "phi=0.7" in targets["peak_rss_mb_n1e5"]["note"]
+    assert [t["status"] for t in targets.values()] == ["met", "not met", "met", "not met"]
+    text = throughput.format_targets(list(targets.values()))
+    assert "40,000" in text and "3.50" in text and "320" in text and text.count("not met") == 2
+
+
+def test_targets_missing_points_are_not_measured(throughput):
+    rows = [_point(1_000, 0.3, 70_000.0), _point(100_000, 0.3, 20_000.0)]  # no RSS, no 10^4, no phi 0.7
+    statuses = [t["status"] for t in throughput.target_rows(rows)]
+    assert statuses == ["not measured", "not met", "not measured", "not measured"]
 
 
 # --- the naive baseline agrees with discsim event by event ------------------------------

@@ -47,6 +47,8 @@ __all__ = ["EventDriven"]
 # A disc's record in the state buffer: x, y, vx, vy, t_ref, radius (float64).
 _RECORD = struct.Struct("6d")
 _RECORD_BYTES = _RECORD.size
+# Position of the cell's index in a cell's static record (see EventDriven._make_predictor).
+_CELL_INDEX = 8
 
 INF = math.inf
 # Kinds of queued events. COLLISION and WALL match discsim.eventlog.
@@ -120,8 +122,6 @@ class EventDriven(Engine):
         pos, vel = discs.positions, discs.velocities
         self._disc = _pack_records(pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1], np.zeros(n), discs.radii)
         self._radius = discs.radii.tolist()
-        self._mass = discs.masses.tolist()
-        self._moving = np.isfinite(discs.masses).tolist()
         self._count = [0] * n
         self._cell = grid.cells_of(pos).tolist()
         members: list[list[int]] = [[] for _ in range(len(grid))]
@@ -167,7 +167,9 @@ class EventDriven(Engine):
         self.segments = segments
         self.pass_through = pass_through
         self._radius = discs.radii.tolist()
-        self._mass = discs.masses.tolist()
+        # Equal masses share one float object, so reading them costs no cache miss.
+        shared: dict[float, float] = {}
+        self._mass = [shared.setdefault(m, m) for m in discs.masses.tolist()]
         self._moving = np.isfinite(discs.masses).tolist()
         self._rebase_every = max(_REBASE_EVENTS, 16 * n)
 
@@ -175,7 +177,7 @@ class EventDriven(Engine):
     # The per-disc records are saved as one array per field (the file format predates the records).
     _RECORD_FIELDS = ("_rx", "_ry", "_vx", "_vy", "_tr")
     _STATE_FLOATS = ("_kept_time",)
-    _STATE_INTS = ("_count", "_cell", "_kept_partner", "_kept_stamp")
+    _STATE_INTS = ("_count", "_kept_partner", "_kept_stamp")
 
     def _records(self) -> np.ndarray:
         """The per-disc records as an ``(N, 6)`` array: x, y, vx, vy, t_ref, radius."""
@@ -187,6 +189,7 @@ class EventDriven(Engine):
         state = {name: records[:, k].copy() for k, name in enumerate(self._RECORD_FIELDS)}
         state.update({name: np.array(getattr(self, name), dtype=np.float64) for name in self._STATE_FLOATS})
         state.update({name: np.array(getattr(self, name), dtype=np.int64) for name in self._STATE_INTS})
+        state["_cell"] = np.array([here[_CELL_INDEX] for here in self._where], dtype=np.int64)
         # Order within a cell decides ties, so it is saved too.
         cells = self._cells[:-1]  # not the always-empty one
         state["cell_members"] = np.array([j for members in cells for j in members], dtype=np.int64)
@@ -232,7 +235,7 @@ class EventDriven(Engine):
             segments,
             [tuple(pair) for pair in settings.get("pass_through", [])],
         )
-        for name in cls._STATE_FLOATS + cls._STATE_INTS:
+        for name in cls._STATE_FLOATS + cls._STATE_INTS + ("_cell",):
             setattr(sim, name, state[name].tolist())
         sim._disc = _pack_records(*(state[name] for name in cls._RECORD_FIELDS), discs.radii)
         sizes = state["cell_sizes"].tolist()
@@ -681,7 +684,7 @@ class EventDriven(Engine):
         The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
         """
         disc, unpack = self._disc, _RECORD.unpack_from
-        cell, count = self._cell, self._count
+        count = self._count
         grid, box = self.grid, self.box
         members = self._cells
         front = {_PLUS_X: (6, 7, 8), _MINUS_X: (0, 1, 2), _PLUS_Y: (2, 5, 8), _MINUS_Y: (0, 3, 6)}
@@ -691,7 +694,9 @@ class EventDriven(Engine):
         reach = max(self._radius, default=0.0)
         segments_near = grid.segments_by_cell(self.segments, reach) if segment_ends else [()] * len(grid)
         # One static record per cell, so a prediction reads one tuple:
-        # (members of the 3x3 block, their minimum-image shifts, xlo, xhi, ylo, yhi, walls, segments).
+        # (members of the 3x3 block, their minimum-image shifts, xlo, xhi, ylo, yhi, walls,
+        # segments, the cell's index). Each disc holds its cell's record in ``where``
+        # (built here from the cell indices in ``_cell``), one pointer away.
         # ``itemgetter`` fetches the 9 member tuples in one call; cells a wall cuts off
         # read the always-empty last entry. ``walls`` has bit 1, 2, 4, 8 set when a wall
         # stands beyond the low-x, high-x, low-y, high-y side. Records share one float
@@ -708,7 +713,10 @@ class EventDriven(Engine):
                 0 if periodic else ((cx == 0) | (cx == grid.nx - 1) << 1 | (cy == 0) << 2 | (cy == grid.ny - 1) << 3)
             )
             block = itemgetter(*(c2 if c2 >= 0 else empty for c2 in near))
-            info.append((block, shift, col_lo[cx], col_hi[cx], row_lo[cy], row_hi[cy], walls, segs))
+            info.append((block, shift, col_lo[cx], col_hi[cx], row_lo[cy], row_hi[cy], walls, segs, c))
+        self._cell_info = info
+        self._where = where = [info[c] for c in self._cell]
+        del self._cell
         kept_time, kept_partner, kept_stamp = self._kept_time, self._kept_partner, self._kept_stamp
         push, discard = self._queue.push, self._queue.discard
         # Collision filter: blocked[g][h] is True when groups g and h pass through each other.
@@ -726,7 +734,7 @@ class EventDriven(Engine):
             dti = t - ti
             xi += vxi * dti
             yi += vyi * dti
-            block, shift, x_lo, x_hi, y_lo, y_hi, walls, segs = info[cell[i]]
+            block, shift, x_lo, x_hi, y_lo, y_hi, walls, segs, _ = where[i]
             block = block(members)
             # 1. The earliest collision with a neighbour.
             partner = kept_partner[i]
@@ -838,7 +846,7 @@ class EventDriven(Engine):
         predict = self._predict
         disc, unpack, pack = self._disc, _RECORD.unpack_from, _RECORD.pack_into
         count, mass, moving = self._count, self._mass, self._moving
-        cell, cells, grid = self._cell, self._cells, self.grid
+        where, info, cells, grid = self._where, self._cell_info, self._cells, self.grid
         nx, ny = grid.nx, grid.ny
         width, height, periodic = self.box.width, self.box.height, self.box.periodic
         log = self._log if self.record else None
@@ -931,7 +939,7 @@ class EventDriven(Engine):
                 predict(i, t, -2 - other)  # never the same segment again straight away
                 last = (t + epoch, _WALL, i, -1)
             else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
-                c = cell[i]
+                c = where[i][_CELL_INDEX]
                 others = cells[c]
                 if len(others) == 1:
                     cells[c] = ()
@@ -964,7 +972,7 @@ class EventDriven(Engine):
                         xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
                         pack(disc, i * _RECORD_BYTES, xi, yi + height, vxi, vyi, ti, ri)
                 c = cx * ny + cy
-                cell[i] = c
+                where[i] = info[c]
                 cells[c] += (i,)
                 n_cross += 1
                 predict(i, t, -1, other)
@@ -1015,7 +1023,7 @@ class EventDriven(Engine):
         expected = self.grid.cells_of(pos)
         grid = self.grid
         for i in range(n):
-            c = self._cell[i]
+            c = self._where[i][_CELL_INDEX]
             assert i in self._cells[c]
             if expected[i] != c:  # only allowed on a cell boundary, within roundoff
                 cx, cy = divmod(c, grid.ny)

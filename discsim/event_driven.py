@@ -25,6 +25,7 @@ re-predict, push.
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import struct
 import uuid
@@ -840,7 +841,24 @@ class EventDriven(Engine):
         """Process events with time <= ``until``; stop after ``limit`` physical events (-1: none).
 
         Returns the number of physical events (collisions plus wall hits) processed.
+
+        Python's cyclic garbage collector is paused meanwhile (and restored as it
+        was). The loop allocates millions of short-lived tuples and never a
+        reference cycle, yet each allocation burst triggers a collection that walks
+        what those tuples point at: memory scattered over the whole system, so at
+        N = 10^5 the collections cost 10-15% of the run (same-process A/B, none
+        at 10^3).
         """
+        if not gc.isenabled():
+            return self._process_events(until, limit)
+        gc.disable()
+        try:
+            return self._process_events(until, limit)
+        finally:
+            gc.enable()
+
+    def _process_events(self, until: float, limit: int) -> int:
+        """The body of :meth:`_process`."""
         queue = self._queue
         pop_before = queue.pop_before
         predict = self._predict

@@ -59,7 +59,7 @@ class EventQueue:
         if time != math.inf:
             self._add((time, owner))
         self._time[owner] = time
-        self._payload[owner] = payload
+        self._payload[owner] = payload if time != math.inf else None
 
     def shift_times(self, delta: float) -> None:
         """Subtract ``delta`` from every pending time (a new time origin). O(n log n)."""
@@ -143,7 +143,7 @@ class HeapEventQueue:
         version = self._version[owner] + 1
         self._version[owner] = version
         self._time[owner] = time
-        self._payload[owner] = payload
+        self._payload[owner] = payload if time != math.inf else None
         if time != math.inf:
             self._live += 1
             heapq.heappush(self._heap, (time, owner, version))
@@ -234,7 +234,10 @@ class CalendarEventQueue:
     the lap ends, the overflow (then every live event) is re-binned from a new
     origin, the earliest pending time, with new ``w`` and ``B``.
 
-    A replaced event that sits in a bin or in the overflow stays there as a
+    An entry is the tuple ``(time, owner, payload)``: ``(time, owner)`` is
+    unique among live entries, so payloads are never compared, and a pop
+    hands the entry itself back. A replaced event that sits in a bin or in
+    the overflow stays there as a
     dead entry (the owner's current entry is another tuple), dropped when its
     bin is loaded or the lap is re-binned. Bin index, membership of the
     ``SortedList`` and lap end all derive from the one float ``(t - base) * (1 / w)``,
@@ -275,8 +278,7 @@ class CalendarEventQueue:
         self._near = SortedList()
         self._near._reset(EventQueue.LOAD)  # helps when many events share the current bin (ties, bursts)
         self._near_add, self._near_remove = self._near.add, self._near.remove
-        self._entry: list = [None] * n_owners  # the owner's live (time, owner) tuple, or None
-        self._payload: list = [None] * n_owners
+        self._entry: list = [None] * n_owners  # the owner's live (time, owner, payload) tuple, or None
         self._live = 0
         self._dead = 0
         self._max_dead = 2 * n_owners + 64
@@ -376,7 +378,6 @@ class CalendarEventQueue:
         """Schedule ``payload`` for ``owner`` at ``time``, replacing its pending event."""
         entries = self._entry
         old = entries[owner]
-        self._payload[owner] = payload
         if old is not None:
             # The old event leaves the SortedList, or stays behind in its bin as a dead entry.
             if (old[0] - self._base) * self._inv_w < self._next:
@@ -394,7 +395,7 @@ class CalendarEventQueue:
             return
         else:
             self._live += 1
-        e = entries[owner] = (time, owner)
+        e = entries[owner] = (time, owner, payload)
         x = (time - self._base) * self._inv_w
         if x < self._next:
             self._near_add(e)
@@ -409,7 +410,7 @@ class CalendarEventQueue:
         entries = self._entry
         for o, e in enumerate(entries):
             if e is not None:
-                entries[o] = (e[0] - delta, o)
+                entries[o] = (e[0] - delta, o, e[2])
         self._near.clear()
         self._rebin([e for e in entries if e is not None])
 
@@ -421,27 +422,21 @@ class CalendarEventQueue:
             if not near:
                 return None
         e = near.pop(0)  # cheaper than near[0] and then pop: the engine's limit is rarely reached
-        time = e[0]
-        if time > until:
+        if e[0] > until:
             near.add(e)
             return None
-        owner = e[1]
-        self._entry[owner] = None
+        self._entry[e[1]] = None
         self._live -= 1
-        payload = self._payload[owner]
-        self._payload[owner] = None
-        return time, owner, payload
+        return e
 
     def pop(self) -> tuple[float, int, object]:
         """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""
         if not self._near:
             self._advance()
-        time, owner = self._near.pop(0)
-        self._entry[owner] = None
+        e = self._near.pop(0)
+        self._entry[e[1]] = None
         self._live -= 1
-        payload = self._payload[owner]
-        self._payload[owner] = None
-        return time, owner, payload
+        return e
 
     def peek(self) -> float:
         """Time of the earliest event, ``math.inf`` if the queue is empty."""
@@ -457,7 +452,7 @@ class CalendarEventQueue:
     def pending(self, owner: int) -> tuple[float, object]:
         """``(time, payload)`` of ``owner``'s pending event (``inf, None`` if none)."""
         e = self._entry[owner]
-        return (math.inf if e is None else e[0]), self._payload[owner]
+        return (math.inf, None) if e is None else (e[0], e[2])
 
     def __len__(self) -> int:
         return self._live

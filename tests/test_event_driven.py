@@ -280,3 +280,26 @@ def test_restoring_state_across_epoch_moves_is_bit_for_bit():
     assert a._epoch > 0 and a._epoch == b._epoch
     assert a.events.tobytes() == b.events.tobytes()
     assert np.array_equal(a.positions, b.positions)
+
+
+def test_run_leaves_the_garbage_collector_as_it_found_it():
+    """The hot loop pauses the cyclic GC; it must restore it, on and off, after errors too."""
+    import gc
+
+    discs, box = ds.random_gas(100, 0.3, seed=15)
+    was = gc.isenabled()
+    try:
+        gc.enable()
+        sim = ds.EventDriven(discs, box).run(events=500)
+        assert gc.isenabled()
+        gc.disable()
+        sim.run(events=500)
+        assert not gc.isenabled()
+        gc.enable()
+        sim.step()
+        assert gc.isenabled()
+        with pytest.raises(ds.TimeError):
+            sim.run(until=sim.time - 1.0)
+        assert gc.isenabled()
+    finally:
+        (gc.enable if was else gc.disable)()

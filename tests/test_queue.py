@@ -52,7 +52,7 @@ class Model:
     def pending(self, owner):
         if owner in self.events:
             return self.events[owner]
-        return math.inf, self.payload[owner]
+        return math.inf, None  # no pending event, whatever was pushed with time inf
 
     def shift_times(self, delta):
         self.events = {o: (t - delta, p) for o, (t, p) in self.events.items()}

@@ -863,7 +863,7 @@ class EventDriven(Engine):
         pop_before = queue.pop_before
         predict = self._predict
         disc, unpack, pack = self._disc, _RECORD.unpack_from, _RECORD.pack_into
-        count, mass, moving = self._count, self._mass, self._moving
+        count, mass = self._count, self._mass
         where, info, cells, grid = self._where, self._cell_info, self._cells, self.grid
         nx, ny = grid.nx, grid.ny
         width, height, periodic = self.box.width, self.box.height, self.box.periodic
@@ -906,17 +906,18 @@ class EventDriven(Engine):
                 overlap = 1.0 - sqrt(dx * dx + dy * dy) / (ri + rj)
                 if overlap > max_overlap:
                     max_overlap = overlap
-                uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mass[i], mass[j])
+                mi, mj = mass[i], mass[j]
+                uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
                 pack(disc, i * _RECORD_BYTES, xi, yi, uxi, uyi, t, ri)
                 pack(disc, j * _RECORD_BYTES, xj, yj, uxj, uyj, t, rj)
-                virial -= mass[i] * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
+                virial -= mi * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
                 count[i] += 1
                 n_coll += 1
                 done += 1
                 if log is not None:
                     log.collision(t + epoch, i, j, xi, yi, uxi, uyi, xj, yj, uxj, uyj)
                 predict(i, t, j)
-                if moving[j]:
+                if mj != INF:  # obstacles never move, and their counter never changes
                     count[j] += 1
                     predict(j, t, i)
                     # Only here can the queue grow (j's slot may have been empty); other

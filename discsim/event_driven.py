@@ -5,8 +5,8 @@ State is one ``bytearray`` of per-disc records, six float64 each:
 :class:`struct.Struct` call (the hot loop works on Python floats, not numpy
 scalars). A record is 48 contiguous bytes, so fetching a neighbour costs one
 cache line: Python lists of float objects cost several, which made large
-systems slow (same-process A/B against lists of tuples: -6% at N = 10^3,
-+10% at 10^4, +13% at 10^5). Each disc flies straight from its reference
+systems slow (same-process A/B against a list of tuples: +4% at N = 10^3,
++8% at 10^4, +7% at 10^5). Each disc flies straight from its reference
 position at its own reference time, ``r + v (t - t_ref)``, until its
 velocity changes: an event touches only the discs it involves (lazy clocks).
 
@@ -683,6 +683,8 @@ class EventDriven(Engine):
         - ``predictions()`` counts the predictions made (from ``n_pred``).
 
         The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
+        Also builds the static per-cell records (``_cell_info``) and points each
+        disc at its cell's record (``_where``, from the indices in ``_cell``).
         """
         disc, unpack = self._disc, _RECORD.unpack_from
         count = self._count

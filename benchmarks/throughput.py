@@ -219,9 +219,7 @@ def measure_pic(n: int, packing_fraction: float, queue: str | None, seed: int, c
         "events": sum(delta.values()),
         "max_queue": sim.max_queue,
         "queue_size": sim.queue_size,
-        # EventDriven has no public view of the queue's storage (entries held, dead ones
-        # included; ``queue_size`` counts live events only), so it is read from the queue.
-        "storage": sim._queue.storage(),
+        "storage": sim.queue_storage,  # entries held, dead ones included (queue_size: live only)
         "simulated_time": sim.time - t_before,
     }
 

@@ -292,6 +292,15 @@ class EventDriven(Engine):
         """Events pending in the queue now (at most N)."""
         return len(self._queue)
 
+    @property
+    def queue_storage(self) -> int:
+        """Entries the queue holds in memory now, replaced (dead) ones included.
+
+        Equals ``queue_size`` for ``queue="sorted"``; at most ``3 N + 64`` for
+        ``"calendar"`` and ``2 N + 16`` for ``"heap"``, which drop dead entries lazily.
+        """
+        return self._queue.storage()
+
     def pressure(self) -> float:
         """Pressure from the collision virial, averaged since the start.
 

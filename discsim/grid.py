@@ -8,6 +8,7 @@ with numpy, for bulk work (input checks, the fixed-step broad phase).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -45,7 +46,7 @@ class CellGrid:
 
     Attributes:
         nx, ny (int): cells along x and y. ``lx, ly`` (float): cell sides.
-        neighbours (list[tuple[int, ...]]): for each cell, the 9 cells of its 3x3
+        neighbours (list[tuple[int, ...]]): built on first use; for each cell, the 9 cells of its 3x3
             block in the order ``(dx, dy)`` for ``dx`` in (-1, 0, 1) for ``dy`` in
             (-1, 0, 1) (itself at position 4); -1 where a wall cuts the block off.
             Entries 6-8 are the block's column on the +x side, 0-2 on the -x
@@ -70,7 +71,7 @@ class CellGrid:
         self.box = box
         self.nx, self.ny = nx, ny
         self.lx, self.ly = box.width / nx, box.height / ny
-        self.neighbours, self.shifts = self._build_tables()
+        self.shifts = self._build_tables(with_neighbours=False)[1]
 
     def __len__(self) -> int:
         return self.nx * self.ny
@@ -109,7 +110,13 @@ class CellGrid:
         empty: tuple[int, ...] = ()
         return [tuple(cell) if cell else empty for cell in table]
 
-    def _build_tables(self):
+    @functools.cached_property
+    def neighbours(self) -> list[tuple[int, ...]]:
+        """The 3x3 block of each cell (see the class docstring); built on first use, 0.3 KB per cell."""
+        return self._build_tables(with_neighbours=True)[0]
+
+    def _build_tables(self, with_neighbours: bool):
+        """``(neighbours, shifts)``; ``neighbours`` is None unless ``with_neighbours``."""
         nx, ny, periodic = self.nx, self.ny, self.box.periodic
         width, height = self.box.width, self.box.height
         ids = list(range(nx * ny))  # shared int objects keep the table small
@@ -132,10 +139,11 @@ class CellGrid:
                             continue
                         cells.append(ids[ox * ny + oy])
                         offs.append((sx, sy))
-                neighbours.append(tuple(cells))
+                if with_neighbours:
+                    neighbours.append(tuple(cells))
                 offs = tuple(offs)
                 shifts.append(shared.setdefault(offs, offs))
-        return neighbours, shifts
+        return (neighbours if with_neighbours else None), shifts
 
 
 def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):

@@ -304,3 +304,38 @@ def test_run_leaves_the_garbage_collector_as_it_found_it():
         assert gc.isenabled()
     finally:
         (gc.enable if was else gc.disable)()
+
+
+# --- the tiled table of cell members ---------------------------------------------------------
+@pytest.mark.parametrize("periodic", [True, False])
+@pytest.mark.parametrize("shape", [(3, 3), (4, 7), (10, 10), (11, 23), (25, 9)])
+def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
+    """Each cell's getter, applied to its tile, returns the members of the grid's 3x3 block, in order."""
+    from discsim.event_driven import _TILE, _tile_cells
+    from discsim.grid import CellGrid
+
+    nx, ny = shape
+    grid = CellGrid(ds.Box(float(nx), float(ny), periodic=periodic), 1.0)
+    assert (grid.nx, grid.ny) == shape
+    members = [(c, c + 1000) if c % 3 else (c,) for c in range(len(grid))]  # a distinct tuple per cell
+    blocks, tiles, slots, ghosts = _tile_cells(grid, members, periodic)
+    for c, near in enumerate(grid.neighbours):
+        assert blocks[c](tiles[c]) == tuple(members[c2] if c2 >= 0 else () for c2 in near)
+        assert tiles[c][slots[c]] is members[c]
+        assert all(tile[slot] is members[c] for tile, slot in ghosts[c])
+    # Every slot a getter reads is the cell's own slot, a ghost copy, or empty beyond a wall.
+    copies = sum(1 + len(g) for g in ghosts)
+    assert copies == sum(sum(1 for m in tile if m) for tile in {id(t): t for t in tiles}.values())
+    assert max(len(tile) for tile in tiles) == (_TILE + 2) ** 2
+
+
+def test_cell_crossings_keep_ghost_copies_in_step():
+    """After many crossings in a box of several tiles, every ghost copy is the cell's own tuple (``_check``)."""
+    from discsim.event_driven import _TILE
+
+    discs, box = ds.random_gas(1500, 0.3, periodic=True, seed=4)
+    sim = ds.EventDriven(discs, box, record=False)
+    assert sim.grid.nx > 2 * _TILE
+    sim.run(events=30_000)
+    assert sim.counts["cell_crossings"] > 30_000
+    sim._check()

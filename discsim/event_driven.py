@@ -55,6 +55,10 @@ _CELL_INDEX, _SLOT, _GHOSTS = 9, 10, 11
 # With a ring of ghost cells a tile holds 12 x 12 = 144 slots, so every slot index is one of
 # CPython's cached small ints and a 3x3 block reads no memory outside its tile.
 _TILE = 10
+# Systems of at least this many discs are numbered internally tile by tile (see _internal_order).
+# Smaller ones fit in the caches, gain nothing, and keep the caller's numbering, which then also
+# decides the order of simultaneous events, as the caller would expect.
+_RENUMBER_MIN = 4096
 
 INF = math.inf
 # Kinds of queued events. COLLISION and WALL match discsim.eventlog.
@@ -125,9 +129,8 @@ class EventDriven(Engine):
         self._setup(discs, box, record, queue, cell_size, segments, pass_through)
         n = len(discs)
         grid = self.grid
-        pos, vel = discs.positions, discs.velocities
-        self._disc = _pack_records(pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1], np.zeros(n), discs.radii)
-        self._radius = discs.radii.tolist()
+        pos, vel, radii = (a[self._order] for a in (discs.positions, discs.velocities, discs.radii))
+        self._disc = _pack_records(pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1], np.zeros(n), radii)
         self._count = [0] * n
         self._cell = grid.cells_of(pos).tolist()
         members: list[list[int]] = [[] for _ in range(len(grid))]
@@ -150,8 +153,8 @@ class EventDriven(Engine):
                 self._predict(i, 0.0, -1)
         self.max_queue = len(self._queue)
 
-    def _setup(self, discs, box, record, queue, cell_size, segments, pass_through) -> None:
-        """Validate and build what depends only on the settings: checks, grid, static lists."""
+    def _setup(self, discs, box, record, queue, cell_size, segments, pass_through, order=None) -> None:
+        """Validate and build what depends only on the settings: checks, grid, internal numbering, static lists."""
         super().__init__(discs, box, record)
         if queue not in _QUEUES:
             msg = f"queue must be one of {sorted(_QUEUES)}, got {queue!r}"
@@ -172,14 +175,25 @@ class EventDriven(Engine):
         self.cell_size = cell_size
         self.segments = segments
         self.pass_through = pass_through
-        self._radius = discs.radii.tolist()
+        # Internally, large systems number their discs tile by tile of cells (see
+        # _internal_order), so that discs close in space are close in memory; the public API,
+        # the event log and the events returned speak the caller's numbering. ``_order[k]``
+        # is the caller's index of internal disc k, ``_rank`` its inverse (None when both
+        # are the identity).
+        if order is None:
+            order = _internal_order(grid, discs.positions) if n >= _RENUMBER_MIN else np.arange(n)
+        self._order = np.asarray(order, dtype=np.int64)
+        identity = bool(np.array_equal(self._order, np.arange(n)))
+        self._rank = None if identity else np.argsort(self._order)
+        self._caller_id = list(range(n)) if identity else self._order.tolist()
+        self._radius = discs.radii[self._order].tolist()
         # Equal masses share one float object, so reading them costs no cache miss.
         shared: dict[float, float] = {}
-        self._mass = [shared.setdefault(m, m) for m in discs.masses.tolist()]
+        self._mass = [shared.setdefault(m, m) for m in discs.masses[self._order].tolist()]
         # The mass of every disc when all are equal and finite (the common case), else None:
         # the hot loop then skips two per-disc lookups, two cache misses at large N.
         self._one_mass = self._mass[0] if len(shared) == 1 and self._mass[0] != INF else None
-        self._moving = np.isfinite(discs.masses).tolist()
+        self._moving = np.isfinite(discs.masses[self._order]).tolist()
         self._rebase_every = max(_REBASE_EVENTS, 16 * n)
 
     # --- saving and restoring ----------------------------------------------------------
@@ -188,9 +202,13 @@ class EventDriven(Engine):
     _STATE_FLOATS = ("_kept_time",)
     _STATE_INTS = ("_count", "_kept_partner", "_kept_stamp")
 
-    def _records(self) -> np.ndarray:
-        """The per-disc records as an ``(N, 6)`` array: x, y, vx, vy, t_ref, radius."""
-        return np.frombuffer(self._disc, dtype=np.float64).reshape(-1, 6).copy()
+    def _records(self, caller: bool = False) -> np.ndarray:
+        """The per-disc records as an ``(N, 6)`` array: x, y, vx, vy, t_ref, radius.
+
+        Rows in the internal numbering, or in the caller's with ``caller=True``.
+        """
+        records = np.frombuffer(self._disc, dtype=np.float64).reshape(-1, 6)
+        return records[self._rank] if caller and self._rank is not None else records.copy()
 
     def _cell_members(self) -> list[tuple[int, ...]]:
         """The discs in each cell (a new list, indexed as the grid's cells)."""
@@ -203,6 +221,7 @@ class EventDriven(Engine):
         state.update({name: np.array(getattr(self, name), dtype=np.float64) for name in self._STATE_FLOATS})
         state.update({name: np.array(getattr(self, name), dtype=np.int64) for name in self._STATE_INTS})
         state["_cell"] = np.array([here[_CELL_INDEX] for here in self._where], dtype=np.int64)
+        state["order"] = np.array(self._order, dtype=np.int64)  # every per-disc array is in this numbering
         # Order within a cell decides ties, so it is saved too.
         cells = self._cell_members()
         state["cell_members"] = np.array([j for members in cells for j in members], dtype=np.int64)
@@ -247,10 +266,11 @@ class EventDriven(Engine):
             settings["cell_size"],
             segments,
             [tuple(pair) for pair in settings.get("pass_through", [])],
+            state["order"] if "order" in state else np.arange(len(discs)),  # older files: caller's numbering
         )
         for name in cls._STATE_FLOATS + cls._STATE_INTS + ("_cell",):
             setattr(sim, name, state[name].tolist())
-        sim._disc = _pack_records(*(state[name] for name in cls._RECORD_FIELDS), discs.radii)
+        sim._disc = _pack_records(*(state[name] for name in cls._RECORD_FIELDS), discs.radii[sim._order])
         sizes = state["cell_sizes"].tolist()
         members = state["cell_members"].tolist()
         sim._cells, k = [], 0
@@ -281,14 +301,14 @@ class EventDriven(Engine):
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
         t = self.time - self._epoch
-        rx, ry, vx, vy, tr, _ = self._records().T
+        rx, ry, vx, vy, tr, _ = self._records(caller=True).T
         out = np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)])
         return self.box.wrap(out) if len(out) else out.reshape(0, 2)
 
     @property
     def velocities(self) -> np.ndarray:
         """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
-        return self._records()[:, 2:4].copy()
+        return self._records(caller=True)[:, 2:4].copy()
 
     def _event_array(self) -> np.ndarray:
         return self._log.to_array()
@@ -414,7 +434,8 @@ class EventDriven(Engine):
         if self._process(INF, 1) == 0:
             return None
         t, kind, i, j = self._last
-        return Event(t, KIND_NAMES[kind], i, j)
+        caller = self._caller_id
+        return Event(t, KIND_NAMES[kind], caller[i], caller[j] if j >= 0 else j)
 
     # --- long runs: progress, streamed logs, checkpoints --------------------------------
     #: Events per chunk of a log streamed by ``run(record_to=...)``; at most this
@@ -747,7 +768,7 @@ class EventDriven(Engine):
         filtering = bool(self.pass_through)
         labels = sorted(set(self.discs.groups.tolist()))
         index = {g: k for k, g in enumerate(labels)}
-        group = [index[g] for g in self.discs.groups.tolist()]
+        group = [index[g] for g in self.discs.groups[self._order].tolist()]
         blocked = [[(min(g, h), max(g, h)) in self.pass_through for h in labels] for g in labels]
         sqrt = math.sqrt
         # The payloads of wall, crossing and segment events, made once and shared:
@@ -899,6 +920,7 @@ class EventDriven(Engine):
         nx, ny = grid.nx, grid.ny
         width, height, periodic = self.box.width, self.box.height, self.box.periodic
         log = self._log if self.record else None
+        caller = self._caller_id  # the caller's numbering, for the log
         counts = self._counts
         segment_ends = [(*seg.p0.tolist(), *seg.p1.tolist()) for seg in self.segments]
         n_coll = n_wall = n_cross = n_stale = 0
@@ -949,7 +971,7 @@ class EventDriven(Engine):
                 n_coll += 1
                 done += 1
                 if log is not None:
-                    log.collision(t + epoch, i, j, xi, yi, uxi, uyi, xj, yj, uxj, uyj)
+                    log.collision(t + epoch, caller[i], caller[j], xi, yi, uxi, uyi, xj, yj, uxj, uyj)
                 predict(i, t, j)
                 if mj != INF:  # obstacles never move, and their counter never changes
                     count[j] += 1
@@ -974,7 +996,7 @@ class EventDriven(Engine):
                 n_wall += 1
                 done += 1
                 if log is not None:
-                    log.wall(t + epoch, i, xi, yi, vxi, vyi)
+                    log.wall(t + epoch, caller[i], xi, yi, vxi, vyi)
                 predict(i, t, -1)
                 last = (t + epoch, _WALL, i, -1)
             elif kind == _SEGMENT:
@@ -988,7 +1010,7 @@ class EventDriven(Engine):
                 n_wall += 1
                 done += 1
                 if log is not None:
-                    log.wall(t + epoch, i, xi, yi, vxi, vyi)
+                    log.wall(t + epoch, caller[i], xi, yi, vxi, vyi)
                 predict(i, t, -2 - other)  # never the same segment again straight away
                 last = (t + epoch, _WALL, i, -1)
             else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
@@ -1083,7 +1105,7 @@ class EventDriven(Engine):
             assert all(tile[slot] is members for tile, slot in here[_GHOSTS]), "a ghost copy is out of date"
         seen = sorted(j for members in cells for j in members)
         assert seen == list(range(n)), "every disc is in exactly one cell"
-        pos = self.positions
+        pos = self.positions[self._order]  # in the internal numbering
         expected = self.grid.cells_of(pos)
         grid = self.grid
         for i in range(n):
@@ -1104,7 +1126,26 @@ class EventDriven(Engine):
             assert t_pending >= self.time - self._epoch - 1e-12 * max(1.0, self.time)
             if self._moving[i] and (self._records()[i, 2] or self._records()[i, 3]):
                 assert payload is not None or t_pending == INF
-        check_fits(Discs(pos, self.velocities, self.discs.radii, self.discs.masses), self.box)
+        check_fits(Discs(self.positions, self.velocities, self.discs.radii, self.discs.masses), self.box)
+
+
+def _internal_order(grid: CellGrid, positions: np.ndarray) -> np.ndarray:
+    """The internal numbering of the discs: tile by tile of ``_TILE`` x ``_TILE`` cells.
+
+    Discs are sorted by tile, then by cell within the tile (stable, so the
+    caller's order stands within a cell). Neighbours then have nearby numbers,
+    and their records, counters and kept collisions share cache lines and
+    pages: at N = 10^5 the caller's order can cost up to 10% (a shuffled
+    gas) against this one. Returns ``order``, ``(N,)``: internal disc k is
+    the caller's disc ``order[k]``.
+    """
+    if not len(positions):
+        return np.zeros(0, dtype=np.int64)
+    cx, cy = np.divmod(grid.cells_of(positions), grid.ny)
+    tiles_y = -(-grid.ny // _TILE)
+    tile = (cx // _TILE) * tiles_y + cy // _TILE
+    key = (tile * _TILE + cx % _TILE) * _TILE + cy % _TILE
+    return np.argsort(key, kind="stable").astype(np.int64)
 
 
 def _tile_cells(grid: CellGrid, members: list[tuple[int, ...]], periodic: bool):

@@ -339,3 +339,42 @@ def test_cell_crossings_keep_ghost_copies_in_step():
     sim.run(events=30_000)
     assert sim.counts["cell_crossings"] > 30_000
     sim._check()
+
+
+# --- the internal numbering of large systems -------------------------------------------------
+def test_the_internal_numbering_is_invisible(monkeypatch):
+    """A large system numbered tile by tile inside gives the caller the same positions, events and ids."""
+    from discsim import event_driven
+    from discsim.event_driven import _RENUMBER_MIN
+
+    gas, box = ds.random_gas(_RENUMBER_MIN + 904, 0.3, periodic=True, seed=5)
+    n = len(gas)
+    shuffled = np.random.default_rng(2).permutation(n)  # neighbours far apart in the caller's numbering
+    masses = np.linspace(1.0, 2.0, n)  # unequal, so that a mix-up of masses would show
+    discs = ds.Discs(gas.positions[shuffled], gas.velocities[shuffled], gas.radii, masses)
+    sim = ds.EventDriven(discs, box)
+    order = sim._order
+    assert sim._rank is not None and sorted(order.tolist()) == list(range(n))
+    assert np.abs(np.diff(order)).mean() > n / 10  # far from the identity on a shuffled input
+    assert np.array_equal(sim.positions, discs.positions) and np.array_equal(sim.velocities, discs.velocities)
+    monkeypatch.setattr(event_driven, "_RENUMBER_MIN", 10 * n)
+    plain = ds.EventDriven(discs, box)  # the caller's numbering inside too
+    assert plain._rank is None
+    first = [sim.step() for _ in range(2000)]
+    second = [plain.step() for _ in range(2000)]
+    for a, b in zip(first, second):
+        assert (a.kind, {a.i, a.j}) == (b.kind, {b.i, b.j})
+        assert a.time == pytest.approx(b.time, rel=1e-12)
+    assert np.allclose(sim.positions, plain.positions, rtol=0, atol=1e-9)
+    assert np.allclose(sim.velocities, plain.velocities, rtol=0, atol=1e-9)
+    assert sim.kinetic_energy() == pytest.approx(plain.kinetic_energy(), rel=1e-12)
+    log = sim.events
+    assert set(log["i"][log["kind"] == 0].tolist()) <= set(range(n))
+    assert np.abs(sim.trajectory([sim.time])[0] - sim.positions).max() < 1e-9
+    sim._check()
+
+
+def test_small_systems_keep_the_callers_numbering():
+    discs, box = ds.random_gas(500, 0.3, seed=2)
+    sim = ds.EventDriven(discs, box)
+    assert sim._rank is None and np.array_equal(sim._order, np.arange(500))

@@ -4,7 +4,10 @@ Run ``python benchmarks/throughput.py`` (about 15 minutes in full, more on a loa
 For each N and packing fraction, a seeded periodic :func:`discsim.random_gas`
 is built, equilibrated for a few collisions per disc (a dense start is a
 crystal and must melt), then timed over a fixed number of collisions. Every
-measurement is the median of several runs, each from its own seed.
+measurement is the median of several runs, each from its own seed; the runs
+of the main section are interleaved over the points (every point once, then
+again), so that a slow spell of a shared machine does not bias the ratios
+between sizes that the engine issue's targets are about.
 
 The main PIC section times the engine's default event queue (the ``queue``
 column names it: ``calendar`` when this was written). The queue section runs
@@ -326,16 +329,22 @@ def pic_throughput_section(config: Config, results: Path) -> list[dict]:
     Ends with the engine issue's targets (:func:`target_rows`), printed and
     written to ``throughput_targets.csv``.
     """
+    # Repeats are interleaved over the points (every point once, then again), so that a slow spell
+    # of this shared machine falls on all sizes alike and the ratios between sizes stay fair.
+    points = [(n, phi) for n in config.sizes for phi in config.fractions]
+    runs: dict[tuple[int, float], list[dict]] = {point: [] for point in points}
+    for seed in range(config.repeats):
+        for n, phi in points:
+            timed = config.timed_collisions(n)
+            announce(f"  PIC N={n:,} phi={phi}: run {seed + 1}/{config.repeats}, {timed:,} collisions")
+            runs[n, phi].append(measure_pic(n, phi, None, seed, config))
     rows = []
-    for n in config.sizes:
-        for phi in config.fractions:
-            announce(f"  PIC N={n:,} phi={phi}: {config.repeats} run(s) of {config.timed_collisions(n):,} collisions")
-            runs = [measure_pic(n, phi, None, seed, config) for seed in range(config.repeats)]
-            row = summarise(runs, n, phi)
-            if config.memory:
-                row["peak_mb"] = peak_memory_mb(n, phi, config)
-                row["rss_import_mb"], row["rss_mb"] = peak_rss_mb(n, phi, config)
-            rows.append(row)
+    for n, phi in points:
+        row = summarise(runs[n, phi], n, phi)
+        if config.memory:
+            row["peak_mb"] = peak_memory_mb(n, phi, config)
+            row["rss_import_mb"], row["rss_mb"] = peak_rss_mb(n, phi, config)
+        rows.append(row)
     print(format_table(rows, THROUGHPUT_COLUMNS))
     keys = [c.key for c in THROUGHPUT_COLUMNS] + ["rss_import_mb", "repeats"]
     write_csv(results / "throughput.csv", rows, keys)

@@ -238,6 +238,7 @@ def summarise(runs: list[dict], n: int, packing_fraction: float) -> dict:
     """One table row from repeated runs of the same point and queue (medians, and the spread of rates)."""
     rates = [r["collisions"] / r["seconds"] for r in runs]
     return {
+        "rates": tuple(rates),  # per run, in seed order (not written to CSV; the targets pair them)
         "n": n,
         "packing_fraction": packing_fraction,
         "queue": runs[0]["queue"],
@@ -388,7 +389,7 @@ def target_rows(rows: list[dict]) -> list[dict]:
     large = [r for (n, _), r in sorted(by_point.items()) if n == 100_000 and not math.isnan(r.get("rss_mb", math.nan))]
     worst = max(large, key=lambda r: r["rss_mb"], default=None)
     measured = [rate(10_000, 0.3), slowdown(0.3), slowdown(0.7), worst["rss_mb"] if worst else math.nan]
-    notes = ["", "", "", ""]
+    notes = ["", _paired_note(by_point, 0.3), _paired_note(by_point, 0.7), ""]
     if worst:
         notes[3] = (
             f"phi={worst['packing_fraction']:g}; {worst['rss_import_mb']:.0f} MB of it after imports; "
@@ -415,6 +416,21 @@ def target_rows(rows: list[dict]) -> list[dict]:
             }
         )
     return out
+
+
+def _paired_note(by_point: dict, phi: float) -> str:
+    """The slowdown of each repeat on its own (N = 10^3 over 10^5, runs paired by seed), or ``""``.
+
+    The main section interleaves its repeats over the points, so run k of both
+    sizes ran in the same stretch of the machine's time; their spread shows
+    how far one median-of-3 figure can be trusted near its limit.
+    """
+    small, large = by_point.get((1_000, phi), {}), by_point.get((100_000, phi), {})
+    pairs = list(zip(small.get("rates", ()), large.get("rates", ())))
+    if len(pairs) < 2:
+        return ""
+    ratios = ", ".join(f"{a / b:.2f}" for a, b in pairs)
+    return f"per repeat (paired by seed): {ratios}"
 
 
 def format_targets(targets: list[dict]) -> str:

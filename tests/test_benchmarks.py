@@ -165,6 +165,17 @@ def test_targets_from_the_medians(throughput):
     assert "40,000" in text and "3.50" in text and "320" in text and text.count("not met") == 2
 
 
+def test_slowdown_targets_note_each_repeat(throughput):
+    """The slowdown notes pair the runs of both sizes by seed: one ratio per repeat."""
+    rows = [_point(1_000, 0.3, 70_000.0), _point(100_000, 0.3, 35_000.0)]
+    rows[0]["rates"], rows[1]["rates"] = (60_000.0, 70_000.0, 80_000.0), (40_000.0, 35_000.0, 32_000.0)
+    targets = {t["target"]: t for t in throughput.target_rows(rows)}
+    assert targets["slowdown_n1e3_over_n1e5_phi0.3"]["measured"] == pytest.approx(2.0)
+    assert targets["slowdown_n1e3_over_n1e5_phi0.3"]["note"] == "per repeat (paired by seed): 1.50, 2.00, 2.50"
+    assert targets["slowdown_n1e3_over_n1e5_phi0.7"]["note"] == ""  # not measured
+    assert "1.50, 2.00, 2.50" in throughput.format_targets(list(targets.values()))
+
+
 def test_targets_missing_points_are_not_measured(throughput):
     rows = [_point(1_000, 0.3, 70_000.0), _point(100_000, 0.3, 20_000.0)]  # no RSS, no 10^4, no phi 0.7
     statuses = [t["status"] for t in throughput.target_rows(rows)]

@@ -156,7 +156,10 @@ FULL = Config(
     repeats=3,
     equilibrate_per_disc=2.0,
     timed_per_disc=5.0,
-    timed_min=50_000,
+    # Every timed segment lasts several seconds: N = 10^3 and 10^4 run as many collisions as
+    # N = 10^5. With 50,000 (under a second at N = 10^3), one slow spell of this shared machine
+    # (seen to last 1-3 s, at 60% of the rate) could fill a whole run of the small sizes.
+    timed_min=500_000,
     queue_sizes=(1_000, 10_000, 100_000),
     queue_fraction=0.3,
     pit_sizes=(1_000, 10_000, 100_000),

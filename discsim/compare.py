@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from discsim.errors import InvalidArgumentError
 from discsim.eventlog import COLLISION, WALL
 from discsim.grid import neighbour_pairs
 from discsim.state import kinetic_energy
@@ -374,14 +375,14 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     for name, engine in (("truth", truth), ("approx", approx)):
         if not getattr(engine, "record", True):
             msg = f"compare() needs the event log of {name}; build the engine with record=True"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
     n = len(truth.discs)
     if len(approx.discs) != n:
         msg = f"the runs have different numbers of discs: truth {n}, approx {len(approx.discs)}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     if truth.box != approx.box:
         msg = f"the runs have different boxes: truth {truth.box}, approx {approx.box}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     for what in ("positions", "velocities", "radii", "masses"):
         a, b = getattr(truth.discs, what), getattr(approx.discs, what)
         differs = ~((a == b) | np.isclose(a, b, rtol=1e-12, atol=0.0))
@@ -391,19 +392,19 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
                 f"the runs do not start from the same discs: disc {i} has {what} "
                 f"{np.asarray(a[i]).tolist()} in truth but {np.asarray(b[i]).tolist()} in approx"
             )
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
     start = max(float(truth.start_time), float(approx.start_time))
     common = min(float(truth.time), float(approx.time))
     horizon = common if until is None else float(until)
     if not (start <= horizon <= common):
         msg = f"until={until!r} must lie within the span both runs cover, [{start!r}, {common!r}]"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     dts = [float(getattr(e, "dt", 0.0) or 0.0) for e in (truth, approx)]
     if window is None:
         window = _default_window(truth.discs, max(dts))
     elif not (window >= 0):
         msg = f"window must be a non-negative number of time units, got {window!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     window = float(window)
 
     # Collisions within the common span (the approximation's up to a window past an explicit until).

@@ -15,7 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from discsim.errors import TimeError
+from discsim.errors import InvalidArgumentError, TimeError
 from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, reconstruct
 from discsim.state import Box, Discs, kinetic_energy, momentum
 
@@ -121,7 +121,7 @@ class Engine(ABC):
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if not self.record:
             msg = "trajectory() needs the event log; build the engine with record=True"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         if times.size and not np.isfinite(times).all():
             msg = f"trajectory times must be finite, got {times[~np.isfinite(times)][0]!r}"
             raise TimeError(msg)
@@ -144,7 +144,7 @@ class Engine(ABC):
             msg = "until must not be NaN"
             raise TimeError(msg)
         if until < self.time:
-            msg = f"until={until!r} is before the current time {self.time!r}"
+            msg = f"until={until!r} is before the current time {float(self.time)!r}"
             raise TimeError(msg)
         return until
 

@@ -11,6 +11,7 @@ __all__ = [
     "BoxTooSmallError",
     "CheckpointError",
     "DiscsimError",
+    "InvalidArgumentError",
     "InvalidDiscsError",
     "OutsideBoxError",
     "OverlapError",
@@ -21,6 +22,10 @@ __all__ = [
 
 class DiscsimError(Exception):
     """Base class of every error discsim raises on purpose."""
+
+
+class InvalidArgumentError(DiscsimError, ValueError):
+    """An argument out of its range: a run limit, a step, an option's name, a scene parameter."""
 
 
 class InvalidDiscsError(DiscsimError, ValueError):

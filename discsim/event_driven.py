@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from discsim.engine import Engine, Event
-from discsim.errors import CheckpointError
+from discsim.errors import CheckpointError, InvalidArgumentError, TimeError
 from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, EventLog, stream_header
 from discsim.grid import CellGrid, check_fits, check_scene
 from discsim.io import RecordWriter, read_state, write_state
@@ -158,17 +158,17 @@ class EventDriven(Engine):
         super().__init__(discs, box, record)
         if queue not in _QUEUES:
             msg = f"queue must be one of {sorted(_QUEUES)}, got {queue!r}"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         segments, pass_through = check_scene(discs, box, segments, pass_through)
         n = len(discs)
         diameter = 2.0 * float(discs.radii.max()) if n else 1.0
         if cell_size is None:
             grid = CellGrid(box, diameter, max_cells=4 * n + 9)
         else:
-            if not cell_size >= diameter:
-                msg = f"cell_size {cell_size!r} is below the largest disc diameter {diameter!r}"
-                raise ValueError(msg)
-            grid = CellGrid(box, float(cell_size))
+            if not (isinstance(cell_size, (int, float, np.integer, np.floating)) and diameter <= cell_size < INF):
+                msg = f"cell_size {cell_size!r} is not finite or is below the largest disc diameter {diameter!r}"
+                raise InvalidArgumentError(msg)
+            grid = CellGrid(box, float(cell_size), what="the cell_size asked for")
         self.grid = grid
         self.time = 0.0
         self.queue_kind = queue
@@ -343,7 +343,7 @@ class EventDriven(Engine):
         elapsed = self.time - self.start_time
         if elapsed <= 0:
             msg = "pressure() needs a run of positive duration"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         return (self.kinetic_energy() + self._virial / (2.0 * elapsed)) / self.box.area
 
     def run(
@@ -363,6 +363,11 @@ class EventDriven(Engine):
                 ``time`` is set to ``until`` at the end.
             events: stop after this many collisions plus wall hits (cell
                 crossings and stale events are bookkeeping and not counted).
+                Without ``until``, the run also ends early when no disc can ever
+                hit anything again. In a periodic box that is proven when every
+                pair drifts alike, or moves relative to itself only along x or
+                only along y and misses; other orbits that never meet on the
+                torus look like slow ones, so give ``until`` for such scenes.
             progress: show a tqdm progress bar (simulated time or events, and
                 collisions per second).
             record_to: stream the event log to this file in chunks of
@@ -387,8 +392,8 @@ class EventDriven(Engine):
             ``self``, so calls chain.
 
         Raises:
-            TimeError: if ``until`` is before ``time`` or NaN.
-            ValueError: if neither limit is given, ``events`` is negative, or
+            TimeError: if ``until`` is before ``time``, NaN, or infinite without ``events``.
+            InvalidArgumentError: if neither limit is given, ``events`` is not a whole number >= 0, or
                 ``checkpoint_every`` is not a positive integer or comes without
                 ``checkpoint``.
             CheckpointError: if ``record_to`` or ``checkpoint`` names a file
@@ -398,19 +403,22 @@ class EventDriven(Engine):
         """
         if until is None and events is None:
             msg = "run() needs until=... or events=..."
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         limit_t = INF if until is None else self._check_until(until)
-        if events is not None and (int(events) != events or events < 0):
+        if events is None and limit_t == INF:
+            msg = "run(until=inf) never ends: give a finite until or events=..."
+            raise TimeError(msg)
+        if events is not None and not _is_count(events):
             msg = f"events must be a non-negative integer, got {events!r}"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         limit_n = -1 if events is None else int(events)
         if checkpoint_every is not None:
             if checkpoint is None:
                 msg = "checkpoint_every needs checkpoint=path"
-                raise ValueError(msg)
+                raise InvalidArgumentError(msg)
             if isinstance(checkpoint_every, bool) or int(checkpoint_every) != checkpoint_every or checkpoint_every < 1:
                 msg = f"checkpoint_every must be a positive integer (physical events), got {checkpoint_every!r}"
-                raise ValueError(msg)
+                raise InvalidArgumentError(msg)
             checkpoint_every = int(checkpoint_every)
         if record_to is None and checkpoint is None and not progress:
             done = self._process(limit_t, limit_n)
@@ -429,7 +437,8 @@ class EventDriven(Engine):
 
         Returns:
             The :class:`~discsim.engine.Event` processed, or None if no disc
-            will ever hit anything.
+            will ever hit anything (see ``events`` in :meth:`run` for how a
+            periodic box proves that).
         """
         if self._process(INF, 1) == 0:
             return None
@@ -468,7 +477,7 @@ class EventDriven(Engine):
         if checkpoint is not None:
             if record_to is not None and Path(record_to).absolute() == checkpoint.absolute():
                 msg = f"record_to and checkpoint must be two different files, got {checkpoint} twice"
-                raise ValueError(msg)
+                raise InvalidArgumentError(msg)
             self._check_checkpoint_target(checkpoint)
         writer = None if record_to is None else self._open_stream(Path(record_to))
         target = {
@@ -703,7 +712,7 @@ class EventDriven(Engine):
                 f"read it with ds.read_events({path!r}) and rebuild positions with "
                 f"ds.trajectory_from_events({path!r}, times)"
             )
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
 
     # --- prediction ------------------------------------------------------------------
     def _make_predictor(self, n_pred: int):
@@ -902,15 +911,70 @@ class EventDriven(Engine):
         at 10^3).
         """
         if not gc.isenabled():
-            return self._process_events(until, limit)
+            return self._process_open(limit) if until == INF else self._process_events(until, limit, -1)
         gc.disable()
         try:
-            return self._process_events(until, limit)
+            return self._process_open(limit) if until == INF else self._process_events(until, limit, -1)
         finally:
             gc.enable()
 
-    def _process_events(self, until: float, limit: int) -> int:
-        """The body of :meth:`_process`."""
+    def _process_open(self, limit: int) -> int:
+        """:meth:`_process` with no time limit: also stop when no disc can ever hit anything again.
+
+        In a periodic box, discs that never meet cross cells forever. The hot
+        loop therefore returns after ``budget`` cell crossings in a row of
+        calls; when a whole budget passed without a collision or wall hit,
+        :meth:`_never_again` looks for a proof that none will ever come, and
+        the budget doubles if it finds none (so the check costs O(log) calls).
+        When it finds one, ``time`` goes back to the last collision or wall hit
+        (or to where the call started): the crossings after it changed nothing.
+        """
+        done, start = 0, self.time
+        budget = 64 + 16 * len(self.discs)
+        while True:
+            crossings = self._counts["cell_crossings"]
+            k = self._process_events(INF, limit - done if limit >= 0 else -1, budget)
+            done += k
+            if done == limit or self._counts["cell_crossings"] - crossings < budget:
+                return done  # the event limit, or nothing left in the queue
+            if k == 0:
+                if self._never_again():
+                    self.time = self._last[0] if done else start
+                    return done
+                budget *= 2
+
+    def _never_again(self) -> bool:
+        """True if, from now on, no pair of discs can ever meet and no disc hits a wall or segment.
+
+        Only periodic boxes (a moving disc always reaches a wall). A pair can
+        never meet when its relative velocity is exactly zero, when its groups
+        pass through each other, or when it moves relative to itself only along
+        x (or only along y) and its minimum-image gap across that motion exceeds
+        the contact distance. Any other pair might meet some day, and the answer is False.
+        """
+        box = self.box
+        if not box.periodic or len(self.discs) < 2:
+            return box.periodic or not self.velocities.any()
+        pos, vel, radii = self.positions, self.velocities, self.discs.radii
+        groups = self.discs.groups
+        size = np.array([box.width, box.height])
+        for i in range(len(pos) - 1):
+            dv = vel[i + 1 :] - vel[i]
+            still = (dv == 0.0).all(axis=1)
+            if self.pass_through:
+                a, b = np.minimum(groups[i], groups[i + 1 :]), np.maximum(groups[i], groups[i + 1 :])
+                still |= np.array([(g, h) in self.pass_through for g, h in zip(a.tolist(), b.tolist())], dtype=bool)
+            gap = pos[i + 1 :] - pos[i]
+            gap -= size * np.round(gap / size)
+            reach = (radii[i] + radii[i + 1 :]) * (1.0 + 1e-9) + 1e-12 * size.max()
+            along_y = (dv[:, 0] == 0.0) & (np.abs(gap[:, 0]) > reach)  # x gap fixed for good
+            along_x = (dv[:, 1] == 0.0) & (np.abs(gap[:, 1]) > reach)
+            if not (still | along_y | along_x).all():
+                return False
+        return True
+
+    def _process_events(self, until: float, limit: int, crossings: int) -> int:
+        """The body of :meth:`_process`; also returns after ``crossings`` cell crossings (-1: no such limit)."""
         queue = self._queue
         pop_before = queue.pop_before
         predict = self._predict
@@ -1058,6 +1122,9 @@ class EventDriven(Engine):
                     tile[slot] = others
                 n_cross += 1
                 predict(i, t, -1, other)
+                if n_cross == crossings:
+                    now = t
+                    break
             now = t
             if done >= rebase_at:
                 self._rebase(now)
@@ -1201,6 +1268,13 @@ def _tile_cells(grid: CellGrid, members: list[tuple[int, ...]], periodic: bool):
                     else:
                         ghosts[c].append((tile, slot))
     return blocks, tiles, slots, [tuple(copies) for copies in ghosts]
+
+
+def _is_count(value) -> bool:
+    """True for a whole number >= 0 (an int, or a float such as 5.0); False for bools, NaN and the rest."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return False
+    return math.isfinite(value) and value >= 0 and int(value) == value
 
 
 def _pack_records(x, y, vx, vy, t_ref, radius) -> bytearray:

@@ -80,6 +80,7 @@ import math
 import numpy as np
 
 from discsim.engine import Engine, Event
+from discsim.errors import InvalidArgumentError
 from discsim.eventlog import EventLog
 from discsim.grid import CellGrid, check_scene, neighbour_pairs
 from discsim.kernels import (
@@ -115,15 +116,15 @@ _PAIR, _WALL, _SEGMENT = 0, 1, 2
 def _positive_finite(name: str, value) -> float:
     if isinstance(value, bool):
         msg = f"{name} must be a positive, finite number, got {value!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     try:
         number = float(value)
     except (TypeError, ValueError) as exc:
         msg = f"{name} must be a positive, finite number, got {value!r}"
-        raise ValueError(msg) from exc
+        raise InvalidArgumentError(msg) from exc
     if not (math.isfinite(number) and number > 0.0):
         msg = f"{name} must be a positive, finite number, got {value!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     return number
 
 
@@ -220,14 +221,14 @@ class FixedStep(Engine):
                 rate = _positive_finite("frame_rate", frame_rate)
                 if not math.isclose(rate * step, 1.0, rel_tol=1e-12):
                     msg = f"give frame_rate or dt, not both: frame_rate={frame_rate!r} but dt={dt!r}"
-                    raise ValueError(msg)
+                    raise InvalidArgumentError(msg)
             rate, by_rate = 1.0 / step, False
         if policy not in POLICIES:
             msg = f"policy must be one of {list(POLICIES)}, got {policy!r}"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         if broad_phase not in BROAD_PHASES:
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else _positive_finite("bisect_tol", bisect_tol)
         segments, pass_through = check_scene(discs, box, segments, pass_through)
         n = len(discs)
@@ -345,14 +346,14 @@ class FixedStep(Engine):
         """
         if until is None and frames is None:
             msg = "run() needs until=... or frames=..."
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         limit_t = math.inf if until is None else self._check_until(until)
         if frames is not None and (isinstance(frames, bool) or int(frames) != frames or frames < 0):
             msg = f"frames must be a non-negative integer, got {frames!r}"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         if limit_t == math.inf and frames is None:
             msg = "run(until=inf) never ends for a fixed-step engine; give frames=... as well"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         # Frames up to `until`, allowing for the roundoff of k * dt.
         due = math.inf
         if limit_t != math.inf:
@@ -444,7 +445,7 @@ class FixedStep(Engine):
                 f"2 * {speed:.6g} * {self.dt:.6g} + {2.0 * self._max_radius:.6g} = {reach:.6g} >= {half:.6g}; "
                 "use a smaller dt or a larger box"
             )
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
 
     def _listed_pairs(self, pos: np.ndarray):
         """Candidate pairs from a Verlet list: the pairs within ``2 r_max + skin`` when it was built.

@@ -13,18 +13,18 @@ import math
 
 import numpy as np
 
-from discsim.errors import BoxTooSmallError, OutsideBoxError, OverlapError
+from discsim.errors import BoxTooSmallError, InvalidArgumentError, OutsideBoxError, OverlapError
 from discsim.state import OVERLAP_TOLERANCE, Box, Discs, Segment, normalize_pass_through
 
 __all__ = ["CellGrid", "check_fits", "check_scene", "neighbour_pairs"]
 
 
-def _cells_along(length: float, min_cell: float, periodic: bool, axis: str) -> int:
+def _cells_along(length: float, min_cell: float, periodic: bool, axis: str, what: str) -> int:
     n = max(1, math.floor(length / min_cell * (1 + 1e-12)))
     if periodic and n < 3:
         msg = (
             f"periodic box {axis}-extent {length:g} is too small for its cell grid: it needs at "
-            f"least 3 cells of side >= {min_cell:g} (the largest disc diameter), i.e. >= {3 * min_cell:g}"
+            f"least 3 cells of side >= {min_cell:g} ({what}), i.e. >= {3 * min_cell:g}"
         )
         raise BoxTooSmallError(msg)
     return n
@@ -39,6 +39,7 @@ class CellGrid:
             diameter, so that touching discs are always in adjacent cells).
         max_cells: upper bound on ``nx * ny``; cells grow beyond
             ``min_cell_size`` to respect it (few discs in a large box).
+        what: what ``min_cell_size`` is, for the error message.
 
     Raises:
         BoxTooSmallError: if the box is periodic and fewer than 3 cells fit
@@ -57,12 +58,14 @@ class CellGrid:
             periodic edge). Equal tuples are shared to keep the table small.
     """
 
-    def __init__(self, box: Box, min_cell_size: float, max_cells: int | None = None):
+    def __init__(
+        self, box: Box, min_cell_size: float, max_cells: int | None = None, what: str = "the largest disc diameter"
+    ):
         if not (min_cell_size > 0 and math.isfinite(min_cell_size)):
             msg = f"min_cell_size must be positive and finite, got {min_cell_size!r}"
-            raise ValueError(msg)
-        nx = _cells_along(box.width, min_cell_size, box.periodic, "x")
-        ny = _cells_along(box.height, min_cell_size, box.periodic, "y")
+            raise InvalidArgumentError(msg)
+        nx = _cells_along(box.width, min_cell_size, box.periodic, "x", what)
+        ny = _cells_along(box.height, min_cell_size, box.periodic, "y", what)
         if max_cells is not None and nx * ny > max_cells:
             scale = math.sqrt(nx * ny / max_cells)
             floor_n = 3 if box.periodic else 1
@@ -301,7 +304,7 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
             raise TypeError(msg)
     if segments and box.periodic:
         msg = "segments need a box with walls (periodic=False)"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     pass_through = normalize_pass_through(pass_through)
     check_fits(discs, box, segments=segments, pass_through=pass_through)
     return segments, pass_through

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 
+from discsim.errors import InvalidArgumentError
+
 __all__ = [
     "closest_point_on_segment",
     "reflect_off_segment",
@@ -212,13 +214,13 @@ def time_of_impact_bisect(test, t0: float, t1: float, tol: float) -> float:
     """
     if not (math.isfinite(t0) and math.isfinite(t1)):
         msg = f"t0 and t1 must be finite, got t0={t0!r}, t1={t1!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     if t1 < t0:
         msg = f"t1 must not be before t0, got t0={t0!r}, t1={t1!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     if not (tol > 0.0 and math.isfinite(tol)):
         msg = f"tol must be a positive, finite number of time units, got {tol!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     lo, hi = t0, t1
     while hi - lo >= tol:
         mid = lo + 0.5 * (hi - lo)

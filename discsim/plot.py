@@ -24,6 +24,7 @@ from matplotlib.collections import PatchCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
+from discsim.errors import InvalidArgumentError
 from discsim.eventlog import COLLISION
 from discsim.state import Discs
 
@@ -373,13 +374,13 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
     sims = list(sim) if isinstance(sim, Sequence) else [sim]
     if not sims:
         msg = "animate() needs at least one engine"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     if path is not None:
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in (".gif", ".mp4"):
             msg = f"animate() saves .gif or .mp4 files, got {str(path)!r}"
-            raise ValueError(msg)
+            raise InvalidArgumentError(msg)
         if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
             msg = f"cannot write {str(path)!r}: MP4 needs ffmpeg, which was not found; save a .gif instead"
             raise RuntimeError(msg)

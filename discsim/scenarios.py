@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from discsim.errors import PackingError
+from discsim.errors import InvalidArgumentError, PackingError
 from discsim.state import Box, Discs
 
 __all__ = [
@@ -32,10 +32,31 @@ _MAX_PACKING = 0.85
 
 
 def _lattice(n: int, side: float, radius: float, periodic: bool, rng: np.random.Generator):
-    """``n`` sites of a near-triangular lattice in a square of ``side``, and their spacing."""
+    """``n`` sites of a near-triangular lattice in a square of ``side``, and their spacing.
+
+    The number of rows follows from ``n``; only when that lattice is too tight
+    for the discs (small ``n``) are the other row counts tried, the widest
+    spacing kept, so every gas that fitted before stays the same.
+    """
     rows = max(2, math.ceil(math.sqrt(n * 2.0 / math.sqrt(3.0))))
     if periodic and rows % 2:
         rows += 1  # an even number of rows keeps the staggering consistent across the wrap
+    sites, spacing = _sites(n, side, radius, periodic, rows)
+    if spacing < 2.0 * radius * (1.0 + 1e-9) and n <= 1000:
+        for other in range(2, n + 2, 2 if periodic else 1):
+            more_sites, more_spacing = _sites(n, side, radius, periodic, other, exact=True)
+            if more_spacing > spacing:
+                sites, spacing = more_sites, more_spacing
+    chosen = np.sort(rng.choice(len(sites), size=n, replace=False))
+    return sites[chosen], spacing
+
+
+def _sites(n: int, side: float, radius: float, periodic: bool, rows: int, exact: bool = False):
+    """All sites of a lattice of ``rows`` rows holding at least ``n``, and its spacing.
+
+    ``exact`` measures the nearest pair of sites (O(sites^2)); the default is
+    the closed form the gases were always made with.
+    """
     cols = max(1, math.ceil(n / rows))
     while cols * rows < n:
         cols += 1
@@ -51,11 +72,17 @@ def _lattice(n: int, side: float, radius: float, periodic: bool, rng: np.random.
     x = x0 + (ii + 0.5 * (jj % 2)) * ax
     y = y0 + jj * ay
     sites = np.column_stack([x.ravel(), y.ravel()])
+    if exact:  # the nearest pair of sites, images across a periodic edge included
+        gap = sites[:, None, :] - sites[None, :, :]
+        if periodic:
+            gap -= side * np.round(gap / side)
+        distance = np.hypot(gap[..., 0], gap[..., 1])
+        np.fill_diagonal(distance, np.inf)
+        return sites, float(distance.min()) if len(sites) > 1 else math.inf
     spacing = min(ax, math.hypot(0.5 * ax, ay)) if cols > 1 else ay
     if not periodic and cols == 1:
         spacing = ay
-    chosen = np.sort(rng.choice(len(sites), size=n, replace=False))
-    return sites[chosen], spacing
+    return sites, spacing
 
 
 def random_gas(
@@ -80,37 +107,53 @@ def random_gas(
         packing_fraction: ``n pi r^2 / area``, in ``(0, 0.85]``.
         periodic: periodic box (True) or reflecting walls.
         seed: seed of ``numpy.random.default_rng``; the same seed gives the same gas.
-        temperature: ``kT`` in energy units (positive).
-        radius: disc radius (length units). mass: disc mass.
+        temperature: ``kT`` in energy units (positive, finite).
+        radius: disc radius (length units). mass: disc mass (positive, finite).
 
     Returns:
         ``(discs, box)``.
 
     Raises:
-        PackingError: if the packing fraction is not in ``(0, 0.85]`` or the
-            lattice cannot hold ``n`` discs without overlap in that box.
+        PackingError: if the packing fraction is not in ``(0, 0.85]``, the
+            lattice cannot hold ``n`` discs without overlap in that box, or a
+            periodic box would be under 3 diameters wide (the engines' cell grid).
+        InvalidArgumentError: if ``n``, ``temperature``, ``radius`` or ``mass``
+            is not a positive (finite) number.
 
     Example:
         >>> discs, box = random_gas(100, 0.3, seed=1)
         >>> len(discs), round(discs.kinetic_energy(), 9), bool(abs(discs.momentum()).max() < 1e-12)
         (100, 100.0, True)
     """
-    if int(n) != n or n < 1:
+    if not _is_whole(n) or n < 1:
         msg = f"n must be a positive integer, got {n!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     n = int(n)
     if not (0.0 < packing_fraction <= _MAX_PACKING):
         msg = f"packing fraction {packing_fraction!r} cannot be reached: it must lie in (0, {_MAX_PACKING}]"
         raise PackingError(msg)
-    if not (temperature > 0 and math.isfinite(temperature)):
-        msg = f"temperature must be positive and finite, got {temperature!r}"
-        raise ValueError(msg)
+    for name, value in (("temperature", temperature), ("radius", radius), ("mass", mass)):
+        if not (isinstance(value, (int, float, np.integer, np.floating)) and 0 < value < math.inf):
+            msg = f"{name} must be positive and finite, got {value!r}"
+            raise InvalidArgumentError(msg)
     rng = np.random.default_rng(seed)
     side = math.sqrt(n * math.pi * radius**2 / packing_fraction)
+    if periodic and side < 6.0 * radius:  # the engines' cell grid needs 3 diameters a side
+        need = math.ceil(36.0 * packing_fraction / math.pi)
+        msg = (
+            f"a periodic box of {n} disc(s) at packing fraction {packing_fraction!r} is {side / (2 * radius):.4g} "
+            f"diameters wide, and the engines need at least 3: use n >= {need}, a lower packing fraction "
+            "or periodic=False"
+        )
+        raise PackingError(msg)
     if not periodic and side < 2.0 * radius:
         msg = f"packing fraction {packing_fraction!r} cannot be reached with {n} disc(s) in a walled box"
         raise PackingError(msg)
-    positions, spacing = _lattice(n, side, radius, periodic, rng)
+    if n == 1:  # no lattice needed: anywhere the disc fits
+        low, high = (0.0, side) if periodic else (radius, side - radius)
+        positions, spacing = rng.uniform(low, high, size=(1, 2)), math.inf
+    else:
+        positions, spacing = _lattice(n, side, radius, periodic, rng)
     slack = spacing - 2.0 * radius
     if slack < 1e-9 * radius:
         msg = (
@@ -118,7 +161,7 @@ def random_gas(
             f"({'periodic' if periodic else 'walled'} box): lattice spacing {spacing:.6g} < diameter {2 * radius:g}"
         )
         raise PackingError(msg)
-    jitter = 0.49 * slack / math.sqrt(2.0)
+    jitter = 0.0 if n == 1 else 0.49 * slack / math.sqrt(2.0)
     positions = positions + rng.uniform(-jitter, jitter, size=positions.shape)
     if periodic:
         positions = np.mod(positions, side)
@@ -354,7 +397,7 @@ def newtons_cradle(n: int = 5) -> Scenario:
     """
     if not _is_whole(n) or n < 2:
         msg = f"n must be an integer >= 2, got {n!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     n = int(n)
     x = np.concatenate([[2.0], 6.0 + 2.0 * np.arange(n - 1)])
     positions = np.column_stack([x, np.full(n, 2.0)])
@@ -393,10 +436,10 @@ def billiard_break(rows: int = 5, speed: float = 20.0) -> Scenario:
     """
     if not _is_whole(rows) or not 1 <= rows <= 12:
         msg = f"rows must be an integer in [1, 12], got {rows!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     if not isinstance(speed, (int, float, np.number)) or not (speed > 0 and math.isfinite(speed)):
         msg = f"speed must be positive and finite, got {speed!r}"
-        raise ValueError(msg)
+        raise InvalidArgumentError(msg)
     rows = int(rows)
     spacing = 2.0 * (1.0 + 1e-6)
     apex = np.array([30.0, 15.0])

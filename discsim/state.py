@@ -120,7 +120,9 @@ class Discs:
         return len(self.radii)
 
     def __repr__(self) -> str:
-        return f"Discs(n={len(self)}, radii in [{self.radii.min(initial=0):g}, {self.radii.max(initial=0):g}])"
+        if len(self) == 0:
+            return "Discs(n=0)"
+        return f"Discs(n={len(self)}, radii in [{self.radii.min():g}, {self.radii.max():g}])"
 
     def replace(self, positions=None, velocities=None) -> Discs:
         """Return new validated discs with other positions and/or velocities."""
@@ -185,6 +187,11 @@ class Box:
                 msg = f"box {name} must be positive and finite, got {value!r}"
                 raise InvalidDiscsError(msg)
             object.__setattr__(self, name, value)
+        flag = self.periodic
+        if not (isinstance(flag, (bool, np.bool_)) or (isinstance(flag, (int, np.integer)) and flag in (0, 1))):
+            # bool("no") would be True
+            msg = f"box periodic must be True or False, got {self.periodic!r}"
+            raise InvalidDiscsError(msg)
         object.__setattr__(self, "periodic", bool(self.periodic))
 
     @property

@@ -378,3 +378,46 @@ def test_small_systems_keep_the_callers_numbering():
     discs, box = ds.random_gas(500, 0.3, seed=2)
     sim = ds.EventDriven(discs, box)
     assert sim._rank is None and np.array_equal(sim._order, np.arange(500))
+
+
+# --- runs with no time limit end when nothing can ever happen again -----------------------------------
+
+
+@pytest.mark.parametrize(
+    ("positions", "velocities"),
+    [
+        ([[5.0, 5.0]], [[1.0, 0.3]]),  # one disc on a torus: nothing to hit
+        ([[2.0, 5.0], [6.0, 5.0]], [[1.0, 0.0], [1.0, 0.0]]),  # drifting alike
+        ([[2.0, 2.0], [6.0, 6.0]], [[1.0, 0.0], [2.0, 0.0]]),  # two lanes along x, 4 apart
+        ([[2.0, 2.0], [6.0, 6.0]], [[0.0, -1.0], [0.0, 0.5]]),  # two lanes along y
+    ],
+)
+def test_step_returns_none_in_a_periodic_box_where_nothing_can_meet(positions, velocities):
+    sim = ds.EventDriven(ds.Discs(positions, velocities, 0.5), ds.Box(10.0, 10.0, periodic=True))
+    assert sim.step() is None
+    assert sim.time == 0.0  # the cell crossings it went through changed nothing
+    sim.run(events=5)
+    assert sim.counts["collisions"] == 0 and sim.time == 0.0
+    sim.run(until=123.0)  # and the run goes on exactly
+    expected = ds.Box(10.0, 10.0, periodic=True).wrap(np.array(positions) + 123.0 * np.array(velocities))
+    np.testing.assert_allclose(sim.positions, expected, atol=1e-12)
+
+
+def test_a_run_by_events_stops_after_the_last_collision_that_can_happen():
+    # Discs 0 and 1 share a lane and meet over and over; disc 2 drifts in a lane of its own.
+    discs = ds.Discs([[2.0, 2.0], [6.0, 2.5], [5.0, 7.0]], [[1.0, 0.0], [2.0, 0.0], [1.5, 0.0]], 0.5)
+    sim = ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True)).run(events=20)
+    assert sim.counts["collisions"] == 20
+    # Crossing lanes: the relative motion runs along x + y = 9 (mod 10), which passes 0.71 from a lattice point.
+    lone = ds.Discs([[2.0, 2.0], [8.0, 5.0]], [[1.0, 0.0], [0.0, 1.0]], 0.5)
+    assert ds.EventDriven(lone, ds.Box(10.0, 10.0, periodic=True)).run(events=1).counts["collisions"] == 1
+
+
+def test_step_by_step_equals_one_run_when_a_run_ends_early():
+    discs = ds.Discs([[2.0, 2.0], [6.0, 6.0]], [[1.0, 0.0], [2.0, 0.0]], 0.5)
+    box = ds.Box(10.0, 10.0, periodic=True)
+    stepped = ds.EventDriven(discs, box)
+    while stepped.step() is not None:
+        pass
+    whole = ds.EventDriven(discs, box).run(events=10)
+    assert stepped.time == whole.time and stepped.counts == whole.counts

@@ -119,3 +119,98 @@ def test_input_arrays_are_copied_and_read_only():
     assert discs.positions[0, 0] == 1.0
     with pytest.raises(ValueError):
         discs.positions[0, 0] = 5.0
+
+
+# --- arguments other than the discs: every error is a DiscsimError --------------------------------------
+
+
+def _one_disc(periodic=False):
+    return ds.EventDriven(ds.Discs([[5.0, 5.0]], [[1.0, 0.3]], 0.5), ds.Box(10.0, 10.0, periodic=periodic))
+
+
+@pytest.mark.parametrize("events", [-1, 1.5, float("nan"), True, "3"])
+def test_run_refuses_an_event_count_that_is_not_a_whole_number(events):
+    sim = _one_disc()
+    with pytest.raises(ds.InvalidArgumentError, match="events must be a non-negative integer"):
+        sim.run(events=events)
+    assert sim.time == 0.0 and sim.counts["predictions"] == 1
+
+
+def test_run_refuses_an_endless_run_before_it_starts():
+    sim = _one_disc()
+    with pytest.raises(ds.TimeError, match="never ends"):
+        sim.run(until=np.inf)
+    with pytest.raises(ds.InvalidArgumentError, match="needs until"):
+        sim.run()
+    assert sim.time == 0.0
+    assert sim.run(until=np.inf, events=3).counts["wall_hits"] == 3  # a count bounds it
+
+
+def test_time_error_prints_plain_numbers():
+    sim = _one_disc().run(until=2.0)
+    with pytest.raises(ds.TimeError, match=r"until=1\.0 is before the current time 2\.0$"):
+        sim.run(until=1.0)
+
+
+@pytest.mark.parametrize(
+    ("call", "error"),
+    [
+        (lambda: ds.EventDriven(*ds.random_gas(20, 0.3), queue="x"), ds.InvalidArgumentError),
+        (lambda: ds.EventDriven(*ds.random_gas(20, 0.3), cell_size=0.5), ds.InvalidArgumentError),
+        (lambda: ds.EventDriven(*ds.random_gas(20, 0.3), cell_size=np.inf), ds.InvalidArgumentError),
+        (lambda: ds.FixedStep(*ds.random_gas(20, 0.3), dt=0.0), ds.InvalidArgumentError),
+        (lambda: ds.random_gas(0, 0.3), ds.InvalidArgumentError),
+        (lambda: _one_disc().pressure(), ds.InvalidArgumentError),
+        (lambda: ds.EventDriven(*ds.random_gas(20, 0.3), record=False).run(until=1).trajectory([0.5]), ds.DiscsimError),
+    ],
+)
+def test_bad_arguments_raise_discsim_errors(call, error):
+    with pytest.raises(error):
+        call()
+
+
+def test_a_box_too_small_for_an_asked_cell_size_names_the_cell_size():
+    discs = ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], 0.5)
+    with pytest.raises(ds.BoxTooSmallError, match=r"side >= 4 \(the cell_size asked for\)"):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True), cell_size=4.0)
+
+
+@pytest.mark.parametrize("flag", ["no", "False", None, 2])
+def test_box_periodic_must_be_a_flag(flag):
+    with pytest.raises(ds.InvalidDiscsError, match="periodic must be True or False"):
+        ds.Box(10.0, 10.0, periodic=flag)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"mass": 0}, "mass must be positive and finite, got 0"),
+        ({"mass": -1.0}, r"mass must be positive and finite, got -1\.0"),
+        ({"mass": np.inf}, "mass must be positive and finite, got inf"),
+        ({"radius": 0.0}, r"radius must be positive and finite, got 0\.0"),
+        ({"temperature": 0}, "temperature must be positive and finite, got 0"),
+    ],
+)
+def test_random_gas_checks_its_parameters(kwargs, match):
+    with pytest.raises(ds.InvalidArgumentError, match=match):
+        ds.random_gas(20, 0.3, **kwargs)
+
+
+@pytest.mark.parametrize(("n", "phi"), [(1, 0.3), (2, 0.2), (3, 0.4), (8, 0.7)])
+def test_random_gas_refuses_periodic_boxes_the_engines_cannot_grid(n, phi):
+    with pytest.raises(ds.PackingError, match=r"diameters wide, and the engines need at least 3: use n >= \d+"):
+        ds.random_gas(n, phi)
+
+
+@pytest.mark.parametrize(("n", "phi", "periodic"), [(1, 0.3, False), (1, 0.05, True), (2, 0.2, False), (4, 0.3, True)])
+def test_small_random_gases_run(n, phi, periodic):
+    discs, box = ds.random_gas(n, phi, periodic=periodic, seed=3)
+    assert len(discs) == n
+    assert discs.kinetic_energy() == pytest.approx(n * 1.0)
+    for engine in (ds.EventDriven(discs, box), ds.FixedStep(discs, box, dt=0.01)):
+        engine.run(until=1.0)
+
+
+def test_discs_repr_shows_the_radius_range():
+    assert repr(ds.Discs([[1, 1], [3, 1]], [[0, 0], [0, 0]], [0.5, 0.7])) == "Discs(n=2, radii in [0.5, 0.7])"
+    assert repr(ds.Discs(np.zeros((0, 2)), np.zeros((0, 2)), 1.0)) == "Discs(n=0)"

@@ -1,0 +1,79 @@
+"""Golden event logs: both engines give, bit for bit, the events recorded before the redesign (issue 14).
+
+The logs were written by ``tests/golden/make_golden.py`` on the pre-redesign engine; every scene is replayed
+here and every field of the log, the final positions, velocities, time, counters and deepest overlap are
+compared exactly. Checkpoint files in the pre-redesign format (``tests/fixtures/v0_*.dsc``) must still load
+and continue to the recorded end.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import discsim as ds
+
+GOLDEN = Path(__file__).resolve().parent / "golden"
+FIXTURES = Path(__file__).resolve().parent / "fixtures"
+
+_spec = importlib.util.spec_from_file_location("make_golden", GOLDEN / "make_golden.py")
+make_golden = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(make_golden)
+
+SCENES = make_golden.all_scenes()
+SLOW = {"ed_rebase", "ed_periodic_5000", "ed_walled_5000"}
+
+
+def assert_matches(sim, path: Path) -> None:
+    """Every stored field of the golden file equals the engine's, bit for bit."""
+    golden = np.load(path)
+    events = sim.events
+    assert len(events) == int(golden["n_events"])
+    if "events" in golden:
+        expected = golden["events"]
+        assert events.dtype == expected.dtype
+        for field in expected.dtype.names:
+            got, want = events[field], expected[field]
+            same = (got == want) | (np.isnan(got) & np.isnan(want)) if got.dtype.kind == "f" else got == want
+            assert same.all(), f"field {field!r} differs first at event {int(np.flatnonzero(~same)[0])}"
+    else:
+        assert events[: len(golden["events_head"])].tobytes() == golden["events_head"].tobytes()
+        assert events[-len(golden["events_tail"]) :].tobytes() == golden["events_tail"].tobytes()
+    assert hashlib.sha256(events.tobytes()).hexdigest() == str(golden["events_sha256"])
+    assert sim.time == float(golden["time"])
+    assert sim.positions.tobytes() == golden["positions"].tobytes()
+    assert sim.velocities.tobytes() == golden["velocities"].tobytes()
+    assert sim.max_overlap == float(golden["max_overlap"])
+    expected_counts = json.loads(str(golden["counts"]))
+    assert {k: sim.counts[k] for k in expected_counts} == expected_counts
+
+
+@pytest.mark.parametrize(
+    "name", [pytest.param(name, marks=pytest.mark.slow) if name in SLOW else name for name in SCENES]
+)
+def test_golden_log(name):
+    engine, build, how = SCENES[name]
+    sim = make_golden.run_scene(engine, build, how)
+    assert_matches(sim, GOLDEN / f"{name}.npz")
+
+
+def test_every_scene_has_a_golden_file():
+    assert {p.stem for p in GOLDEN.glob("*.npz")} == set(SCENES)
+
+
+@pytest.mark.parametrize(
+    ("fixture", "how"),
+    [("v0_walled_segments", {"until": 4.0}), ("v0_periodic_4200", {"events": 4000})],
+)
+def test_pre_redesign_checkpoint_continues_bit_for_bit(tmp_path, fixture, how):
+    path = tmp_path / f"{fixture}.dsc"
+    shutil.copy(FIXTURES / f"{fixture}.dsc", path)
+    sim = ds.load(path)
+    sim.run(**how)
+    assert_matches(sim, FIXTURES / f"{fixture}.npz")

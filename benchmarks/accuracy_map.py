@@ -24,7 +24,7 @@ one frame): about two collisions per disc, so that errors have little time to
 grow by chaos (at the largest steps one frame is longer, and ``H`` with it).
 PIT (each response policy of :class:`discsim.FixedStep`) and PIC run from the
 same start; PIT goes on one frame past ``H`` (PIC further), and
-:func:`discsim.compare` judges PIT on PIC's collisions in ``[0, H]``:
+:func:`discsim.analysis.compare` judges PIT on PIC's collisions in ``[0, H]``:
 
 * ``missed``: the fraction of PIC's collisions that PIT lacks;
 * ``direction error``: mean angle (degrees) between the outgoing velocities of
@@ -77,7 +77,7 @@ from benchutils import (
 import discsim as ds
 
 #: Response policies (those this discsim has), one row of panels each.
-POLICIES = tuple(p for p in ("resolve", "revert", "separate", "bisect", "swept") if p in ds.fixed_step.POLICIES)
+POLICIES = tuple(p for p in ("resolve", "revert", "separate", "bisect", "swept") if p in ds.POLICIES)
 #: Units: radius 1 and kT = 1/2 with mass 1, so the rms speed is 1 and dt = s.
 RADIUS = 1.0
 TEMPERATURE = 0.5

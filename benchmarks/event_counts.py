@@ -21,7 +21,7 @@ unit time, so that every frame rate ends on a frame at ``H`` (the dense gas:
 one frame at 15 fps, about five collisions per disc). Study cases: the
 scenario's ``until``. Every engine runs from the same start to ``H``; its
 counts and wall-clock time are taken there. Then each run goes on for two more
-frames (PIC for two frames of the slowest rate) and :func:`discsim.compare`
+frames (PIC for two frames of the slowest rate) and :func:`discsim.analysis.compare`
 judges PIT against PIC on the collisions PIC has in ``[0, H]`` (the extra
 frames let PIT report a collision just before ``H`` late instead of missing it).
 
@@ -81,7 +81,7 @@ import discsim as ds
 #: The issue's frame rates (frames per unit of simulated time).
 FRAME_RATES = (15, 30, 60, 120, 240, 480, 960)
 #: Response policies, in the order shown (those this discsim has).
-POLICIES = tuple(p for p in ("resolve", "revert", "separate", "bisect", "swept") if p in ds.fixed_step.POLICIES)
+POLICIES = tuple(p for p in ("resolve", "revert", "separate", "bisect", "swept") if p in ds.POLICIES)
 #: Gas units: radius, and kT giving an rms speed of 30 (2D, mass 1: <v^2> = 2 kT).
 RADIUS = 1.0
 V_RMS = 30.0

@@ -37,7 +37,7 @@ same ``dt``: the frame step at which FixedStep misses at most 1% of collisions
 * ``s/frame``: median of ``repeats`` timings of ``pit_frames`` frames (no
   callbacks installed), and each engine's ratio to pymunk;
 * over ``T`` (a couple of mean free times), against PIC from the same start:
-  FixedStep through :func:`discsim.compare`; pymunk through a collision handler
+  FixedStep through :func:`discsim.analysis.compare`; pymunk through a collision handler
   whose ``begin`` callback records each disc pair that starts touching, with
   the step's time, matched to PIC's collisions by pair, nearest times first,
   within the window ``compare`` used (a pair in lasting contact counts once);

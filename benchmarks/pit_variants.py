@@ -21,7 +21,7 @@ Columns, as printed and written to ``pit_variants.csv`` in ``--results``:
 
 * ``collisions``: disc-disc collisions the variant logged (PIC: the truth).
 * ``missed``, ``spurious``: collisions of the truth that the variant does not
-  have, and the reverse, from :func:`discsim.compare` (same pair within its
+  have, and the reverse, from :func:`discsim.analysis.compare` (same pair within its
   default window). In a gas, a missed collision sends the paths apart and
   ``compare`` then counts what follows as missed and spurious too.
 * ``dir err``: largest error in degrees of a matched collision's outgoing
@@ -163,7 +163,7 @@ def main(argv=None) -> int:
     print()
     print(format_table(rows, COLUMNS))
     print(
-        "\nmissed/spurious/dir err/delay/overlap from discsim.compare against PIC; pair tests and bisections"
+        "\nmissed/spurious/dir err/delay/overlap from discsim.analysis.compare against PIC; pair tests and bisections"
         " from FixedStep.counts; predictions from EventDriven.counts; seconds: median wall-clock of build + run."
     )
     path = write_csv(args.results / "pit_variants.csv", rows, CSV_KEYS)

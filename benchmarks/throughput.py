@@ -56,7 +56,7 @@ PIT (fixed-step) sections, on the same kind of equilibrated periodic gas:
   (cell grid, policy ``resolve``) at that 1% frame step, timed side by side from
   the same gases. The step ``s = v dt / r`` (``v`` the rms speed) is read from
   ``accuracy_map_boundary.csv`` (column ``largest_step_missed_ok``), or measured
-  with :func:`discsim.compare` when that file is missing; the output says
+  with :func:`discsim.analysis.compare` when that file is missing; the output says
   which. ``crossover step``: the step at which PIT would cost as much as PIC.
 
 Targets: the end of the PIC section prints the engine issue's targets
@@ -633,7 +633,7 @@ def one_percent_step(packing_fraction: float, results: Path) -> tuple[float, str
 
     Read from ``accuracy_map_boundary.csv`` (``largest_step_missed_ok``, the
     nearest packing fraction on the map) in ``results`` or the default results
-    folder; when neither has it, measured here with :func:`discsim.compare`
+    folder; when neither has it, measured here with :func:`discsim.analysis.compare`
     (:func:`measure_one_percent_step`).
 
     Returns:
@@ -657,7 +657,7 @@ def measure_one_percent_step(packing_fraction: float, n: int = 200) -> float:
     """The largest of :data:`_FALLBACK_STEPS` at which PIT misses at most 1% of PIC's collisions.
 
     One equilibrated periodic gas, two mean free times, PIC and PIT from the
-    same start, judged by :func:`discsim.compare`. Returns the smallest step
+    same start, judged by :func:`discsim.analysis.compare`. Returns the smallest step
     tried if none is good.
     """
     discs, box = _equilibrated(n, packing_fraction, 0, 5.0)

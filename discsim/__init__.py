@@ -14,9 +14,11 @@ The public API::
 """
 
 from discsim import scenarios
-from discsim.checkpoint import checkpoint_info, load, resume
-from discsim.compare import Comparison, compare
-from discsim.engine import Event
+from discsim.analysis.compare import Comparison, compare
+from discsim.analysis.theory import enskog_collision_rate, henderson_z, speed_cdf, speed_pdf
+from discsim.analysis.thermo import compressibility_factor
+from discsim.engines.event_driven import EventDriven
+from discsim.engines.fixed_step import POLICIES, FixedStep
 from discsim.errors import (
     BoxTooSmallError,
     CheckpointError,
@@ -28,16 +30,27 @@ from discsim.errors import (
     PackingError,
     TimeError,
 )
-from discsim.event_driven import EventDriven
-from discsim.eventlog import StreamedEvents, read_events, trajectory_from_events
-from discsim.fixed_step import FixedStep
-from discsim.observables import compressibility_factor, enskog_collision_rate, henderson_z, speed_cdf, speed_pdf
+from discsim.events import EVENT_DTYPE, Event, EventKind
+from discsim.io.checkpoints import checkpoint_info, load, resume
+from discsim.io.streams import StreamedEvents, read_events, trajectory_from_events
+from discsim.model import Box, Discs, Segment, polygon
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
-from discsim.state import Box, Discs, Segment, polygon
 
 __version__ = "0.1.0"
 
+
+def __getattr__(name: str):
+    """``ds.plot``: the plotting module, imported (with matplotlib) on first use."""
+    if name == "plot":
+        import importlib
+
+        return importlib.import_module("discsim.plot")
+    msg = f"module 'discsim' has no attribute {name!r}"
+    raise AttributeError(msg)
+
 __all__ = [
+    "EVENT_DTYPE",
+    "POLICIES",
     "Box",
     "BoxTooSmallError",
     "CheckpointError",
@@ -46,6 +59,7 @@ __all__ = [
     "DiscsimError",
     "Event",
     "EventDriven",
+    "EventKind",
     "FixedStep",
     "InvalidArgumentError",
     "InvalidDiscsError",

@@ -20,7 +20,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from discsim.fixed_step import POLICIES
+from discsim.engines.fixed_step import POLICIES
 
 __all__ = ["build_parser", "main"]
 

@@ -25,8 +25,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
 from discsim.errors import InvalidArgumentError
-from discsim.eventlog import COLLISION
-from discsim.state import Discs
+from discsim.events import COLLISION
+from discsim.model import Discs
 
 __all__ = ["animate", "close", "plot_case", "plot_state", "plot_trajectories", "save_figure"]
 
@@ -103,7 +103,7 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
 
     Args:
         sim_or_discs: an engine (drawn at its current ``time``) or a
-            :class:`~discsim.state.Discs`.
+            :class:`~discsim.model.Discs`.
         ax: matplotlib axes to draw on; None makes a new figure.
         box: the box to outline; default the engine's box (none for bare discs).
         arrows: draw velocity arrows; the longest is four radii of the largest

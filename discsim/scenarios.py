@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim.errors import InvalidArgumentError, PackingError
-from discsim.state import Box, Discs
+from discsim.model import Box, Discs
 
 __all__ = [
     "Scenario",

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import discsim as ds
-import discsim.io as dio
+import discsim.io.container as dio
 from discsim.errors import CheckpointError
 
 
@@ -469,7 +469,7 @@ def test_the_log_on_disk_costs_about_89_bytes_per_event(tmp_path):
     path = tmp_path / "events.dse"
     ds.EventDriven(discs, box, record=False).run(events=20_000, record_to=path)
     per_event = path.stat().st_size / 20_000
-    assert ds.eventlog.EVENT_DTYPE.itemsize == 89
+    assert ds.EVENT_DTYPE.itemsize == 89
     assert 89 <= per_event < 89.5, per_event
 
 
@@ -488,7 +488,7 @@ def test_record_streams_refuse_what_they_cannot_hold(tmp_path):
 
 def test_save_load_of_a_renumbered_system_continues_bit_for_bit(tmp_path):
     """Large systems are numbered internally tile by tile; a checkpoint keeps that numbering."""
-    from discsim.event_driven import _RENUMBER_MIN
+    from discsim.engines.event_driven.engine import _RENUMBER_MIN
 
     discs, box = ds.random_gas(_RENUMBER_MIN + 500, 0.3, periodic=False, seed=8)
     shuffled = np.random.default_rng(1).permutation(len(discs))

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import discsim as ds
-from discsim.engine import Engine
-from discsim.eventlog import EVENT_DTYPE
+from discsim.engines.base import Engine
+from discsim.events import EVENT_DTYPE
 
 NAN = math.nan
 

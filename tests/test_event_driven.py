@@ -311,8 +311,8 @@ def test_run_leaves_the_garbage_collector_as_it_found_it():
 @pytest.mark.parametrize("shape", [(3, 3), (4, 7), (10, 10), (11, 23), (25, 9)])
 def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
     """Each cell's getter, applied to its tile, returns the members of the grid's 3x3 block, in order."""
-    from discsim.event_driven import _TILE, _tile_cells
-    from discsim.grid import CellGrid
+    from discsim.cells import CellGrid
+    from discsim.engines.event_driven.engine import _TILE, _tile_cells
 
     nx, ny = shape
     grid = CellGrid(ds.Box(float(nx), float(ny), periodic=periodic), 1.0)
@@ -331,7 +331,7 @@ def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
 
 def test_cell_crossings_keep_ghost_copies_in_step():
     """After many crossings in a box of several tiles, every ghost copy is the cell's own tuple (``_check``)."""
-    from discsim.event_driven import _TILE
+    from discsim.engines.event_driven.engine import _TILE
 
     discs, box = ds.random_gas(1500, 0.3, periodic=True, seed=4)
     sim = ds.EventDriven(discs, box, record=False)
@@ -344,8 +344,8 @@ def test_cell_crossings_keep_ghost_copies_in_step():
 # --- the internal numbering of large systems -------------------------------------------------
 def test_the_internal_numbering_is_invisible(monkeypatch):
     """A large system numbered tile by tile inside gives the caller the same positions, events and ids."""
-    from discsim import event_driven
-    from discsim.event_driven import _RENUMBER_MIN
+    from discsim.engines.event_driven.engine import _RENUMBER_MIN
+    from discsim.engines.event_driven import engine as event_driven
 
     gas, box = ds.random_gas(_RENUMBER_MIN + 904, 0.3, periodic=True, seed=5)
     n = len(gas)

@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import discsim as ds
-from discsim import fixed_step
-from discsim.engine import Event
+from discsim.engines.fixed_step import engine as fixed_step
 from discsim.errors import BoxTooSmallError, OutsideBoxError, OverlapError, TimeError
+from discsim.events import Event
 
 POLICIES = ["resolve", "revert", "separate"]
 

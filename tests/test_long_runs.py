@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import discsim as ds
-from discsim.grid import neighbour_pairs
+from discsim.cells import neighbour_pairs
 
 
 def _deepest_overlap(sim):

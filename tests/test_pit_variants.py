@@ -20,9 +20,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import discsim as ds
-from discsim.engine import Event
+from discsim.engines.fixed_step import POLICIES
 from discsim.errors import InvalidDiscsError, OutsideBoxError
-from discsim.fixed_step import POLICIES
+from discsim.events import Event
 from discsim.kernels import time_of_impact, time_of_impact_bisect
 
 BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"

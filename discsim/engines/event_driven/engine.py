@@ -34,14 +34,16 @@ from pathlib import Path
 
 import numpy as np
 
-from discsim.engine import Engine, Event
+from discsim.cells import CellGrid
+from discsim.engines.base import Engine
 from discsim.errors import CheckpointError, InvalidArgumentError, TimeError
-from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, EventLog, stream_header
-from discsim.grid import CellGrid, check_fits, check_scene
-from discsim.io import RecordWriter, read_state, write_state
+from discsim.events import EVENT_DTYPE, KIND_NAMES, Event, EventLog
+from discsim.io.container import RecordWriter, read_state, write_state
+from discsim.io.streams import stream_header
 from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
+from discsim.model import Box, Discs, Segment
 from discsim.queue import CalendarEventQueue, EventQueue, HeapEventQueue
-from discsim.state import Box, Discs, Segment
+from discsim.scene import check_fits, check_scene
 
 __all__ = ["EventDriven"]
 
@@ -88,7 +90,7 @@ class EventDriven(Engine):
         cell_size: side of the grid cells; default the largest disc diameter,
             grown where needed so that there are at most ``4 N + 9`` cells.
             Never below the largest diameter.
-        segments: fixed :class:`~discsim.state.Segment` walls (walled boxes
+        segments: fixed :class:`~discsim.model.Segment` walls (walled boxes
             only), kept in a static per-cell table built once.
         pass_through: pairs of group labels (``discs.groups``) whose discs do
             not collide with each other, e.g. ``{(1, 1)}`` for bullets that
@@ -471,7 +473,7 @@ class EventDriven(Engine):
         The slices change nothing in the dynamics: ``_process`` resumes exactly
         where it stopped. Returns the physical events processed.
         """
-        from discsim.progress import progress_bar
+        from discsim.run.progress import progress_bar
 
         checkpoint = None if checkpoint is None else Path(checkpoint)
         if checkpoint is not None:
@@ -680,7 +682,7 @@ class EventDriven(Engine):
 
     @property
     def events(self) -> np.ndarray:
-        """The recorded event log: a structured array ``(E,)`` of :data:`~discsim.eventlog.EVENT_DTYPE`.
+        """The recorded event log: a structured array ``(E,)`` of :data:`~discsim.events.EVENT_DTYPE`.
 
         Empty when the engine was built with ``record=False``.
 

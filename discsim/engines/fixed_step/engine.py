@@ -9,7 +9,7 @@ the engine took, and :meth:`~discsim.engine.Engine.trajectory` works as for
 the event-driven engine.
 
 A frame is vectorised with numpy: the move, the wall and segment tests, the
-broad phase (:func:`discsim.grid.neighbour_pairs`, or all pairs) and the
+broad phase (:func:`discsim.cells.neighbour_pairs`, or all pairs) and the
 narrow phase are array operations. Only the few pairs found overlapping are
 visited one by one.
 
@@ -79,10 +79,10 @@ import math
 
 import numpy as np
 
-from discsim.engine import Engine, Event
+from discsim.cells import CellGrid, neighbour_pairs
+from discsim.engines.base import Engine
 from discsim.errors import InvalidArgumentError
-from discsim.eventlog import EventLog
-from discsim.grid import CellGrid, check_scene, neighbour_pairs
+from discsim.events import Event, EventLog
 from discsim.kernels import (
     closest_point_on_segment,
     reflect_off_segment,
@@ -92,7 +92,8 @@ from discsim.kernels import (
     time_of_impact_bisect,
     wall_time,
 )
-from discsim.state import Box, Discs
+from discsim.model import Box, Discs
+from discsim.scene import check_scene
 
 __all__ = ["BROAD_PHASES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
 
@@ -144,11 +145,11 @@ class FixedStep(Engine):
             half the skin: O(N) per frame) or ``"all-pairs"`` (every pair tested,
             O(N^2) per frame). Both give identical results.
         record: keep the event log (needed by ``events`` and ``trajectory``).
-        segments: fixed :class:`~discsim.state.Segment` walls (walled boxes
+        segments: fixed :class:`~discsim.model.Segment` walls (walled boxes
             only), tested against every disc at each frame (few segments).
         pass_through: pairs of group labels (``discs.groups``) whose discs do
             not collide with each other, as for
-            :class:`~discsim.event_driven.EventDriven`. Free when empty.
+            :class:`~discsim.engines.event_driven.EventDriven`. Free when empty.
         bisect_tol: the ``"bisect"`` policy's tolerance on contact times (time
             units; default ``1e-6 * dt``).
 
@@ -157,12 +158,12 @@ class FixedStep(Engine):
             positive finite number, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy or broad phase, or segments in
             a periodic box.
-        TypeError: if a segment is not a :class:`~discsim.state.Segment`.
+        TypeError: if a segment is not a :class:`~discsim.model.Segment`.
         InvalidDiscsError: on a malformed ``pass_through``.
         OutsideBoxError, OverlapError: if the discs do not fit in the box (or
             are cut by a segment).
         BoxTooSmallError: if a periodic box is under three disc diameters a
-            side (as for :class:`~discsim.event_driven.EventDriven`).
+            side (as for :class:`~discsim.engines.event_driven.EventDriven`).
 
     Attributes:
         time (float): the current time; frames fall at ``k * dt``.
@@ -360,7 +361,7 @@ class FixedStep(Engine):
             due = max(0, math.floor((limit_t - self.frame_time(self.frames)) / self.dt * (1 + 1e-12) + 1e-9))
         todo = int(min(due, math.inf if frames is None else int(frames)))
         if progress:
-            from discsim.progress import progress_bar
+            from discsim.run.progress import progress_bar
 
             with progress_bar(todo, by_time=False) as bar:
                 done = 0

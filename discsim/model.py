@@ -2,7 +2,7 @@
 
 Both classes check their input once, at construction, and are immutable
 afterwards; engines copy what they need and trust it. Checks that need both
-(inside the box, no overlaps) live in :func:`discsim.grid.check_fits`.
+(inside the box, no overlaps) live in :class:`discsim.scene.Scene`.
 """
 
 from __future__ import annotations

@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from discsim.cells import neighbour_pairs
 from discsim.errors import InvalidArgumentError
-from discsim.eventlog import COLLISION, WALL
-from discsim.grid import neighbour_pairs
-from discsim.state import kinetic_energy
+from discsim.events import COLLISION, WALL
+from discsim.model import kinetic_energy
 
 __all__ = ["Comparison", "compare"]
 
@@ -341,8 +341,8 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     choose another trade-off.
 
     Args:
-        truth: the reference run (e.g. :class:`~discsim.event_driven.EventDriven`).
-        approx: the run to judge (e.g. :class:`~discsim.fixed_step.FixedStep`).
+        truth: the reference run (e.g. :class:`~discsim.engines.event_driven.EventDriven`).
+        approx: the run to judge (e.g. :class:`~discsim.engines.fixed_step.FixedStep`).
             Both need ``record=True``, the same discs at the same start time
             and the same box.
         window: matching window in time units (>= 0), overriding the default.

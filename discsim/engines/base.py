@@ -1,6 +1,6 @@
 """What every engine shares: the public protocol and the methods derived from it.
 
-An engine holds ``discs`` (the initial :class:`~discsim.state.Discs`), ``box``,
+An engine holds ``discs`` (the initial :class:`~discsim.model.Discs`), ``box``,
 ``time``, ``positions`` and ``velocities``, ``counts`` and an event log, and
 implements ``run`` and ``step``. Everything else (energies, momentum, the log
 as an array, exact trajectories) is derived here once for all engines, so that
@@ -11,35 +11,15 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from typing import NamedTuple
 
 import numpy as np
 
 from discsim.errors import InvalidArgumentError, TimeError
-from discsim.eventlog import EVENT_DTYPE, KIND_NAMES, reconstruct
-from discsim.state import Box, Discs, kinetic_energy, momentum
+from discsim.events import EVENT_DTYPE
+from discsim.model import Box, Discs, kinetic_energy, momentum
+from discsim.trajectory import reconstruct
 
-__all__ = ["Engine", "Event"]
-
-
-class Event(NamedTuple):
-    """One processed event, as returned by ``step()``.
-
-    Attributes:
-        time: when it happened.
-        kind: ``"collision"`` (disc-disc) or ``"wall"``.
-        i: the first disc. j: the second disc, or -1 for a wall hit.
-    """
-
-    time: float
-    kind: str
-    i: int
-    j: int
-
-
-def event_from_record(record) -> Event:
-    """The :class:`Event` of one row of an :data:`EVENT_DTYPE` array."""
-    return Event(float(record["time"]), KIND_NAMES[int(record["kind"])], int(record["i"]), int(record["j"]))
+__all__ = ["Engine"]
 
 
 class Engine(ABC):
@@ -88,7 +68,7 @@ class Engine(ABC):
     # --- derived ---------------------------------------------------------------------
     @property
     def events(self) -> np.ndarray:
-        """The recorded event log: a structured array ``(E,)`` of :data:`~discsim.eventlog.EVENT_DTYPE`.
+        """The recorded event log: a structured array ``(E,)`` of :data:`~discsim.events.EVENT_DTYPE`.
 
         Empty when the engine was built with ``record=False``.
         """
@@ -97,7 +77,7 @@ class Engine(ABC):
         return self._event_array()
 
     def snapshot(self) -> Discs:
-        """The discs as they are now: a new :class:`~discsim.state.Discs` at ``time``.
+        """The discs as they are now: a new :class:`~discsim.model.Discs` at ``time``.
 
         Use it to start a fresh engine (or measurement) from an equilibrated state.
         """

@@ -1,4 +1,4 @@
-"""Physical reference values and measurements for hard-disc systems.
+"""Physical reference values for hard-disc systems.
 
 Closed forms to compare simulations against: the Henderson equation of state
 and the Enskog collision rate. Units: lengths in disc radii or diameters as
@@ -11,15 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = [
-    "compressibility_factor",
-    "contact_value",
-    "enskog_collision_rate",
-    "henderson_z",
-    "packing_fraction",
-    "speed_cdf",
-    "speed_pdf",
-]
+__all__ = ["contact_value", "enskog_collision_rate", "henderson_z", "speed_cdf", "speed_pdf"]
 
 
 def henderson_z(packing_fraction):
@@ -79,13 +71,3 @@ def enskog_collision_rate(packing_fraction, radius: float = 1.0, kT: float = 1.0
     sigma = 2.0 * radius
     density = eta / (math.pi * radius**2)
     return 2.0 * sigma * density * contact_value(eta) * np.sqrt(math.pi * kT / mass)
-
-
-def packing_fraction(radii: np.ndarray, area: float) -> float:
-    """Fraction of ``area`` covered by discs of ``radii`` ``(N,)``."""
-    return float(math.pi * np.sum(np.asarray(radii, dtype=float) ** 2) / area)
-
-
-def compressibility_factor(sim) -> float:
-    """``Z = P A / (N kT)`` of an event-driven run (``N kT`` is the kinetic energy)."""
-    return sim.pressure() * sim.box.area / sim.kinetic_energy()

@@ -19,9 +19,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from discsim.engines.event_driven import EventDriven
 from discsim.errors import CheckpointError, DiscsimError
-from discsim.event_driven import EventDriven
-from discsim.io import read_state
+from discsim.io.container import read_state
 
 __all__ = ["checkpoint_info", "load", "resume"]
 

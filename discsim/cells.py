@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
-from discsim.errors import BoxTooSmallError, InvalidArgumentError, OutsideBoxError, OverlapError
-from discsim.state import OVERLAP_TOLERANCE, Box, Discs, Segment, normalize_pass_through
+from discsim.errors import BoxTooSmallError, InvalidArgumentError
+from discsim.model import Box
 
-__all__ = ["CellGrid", "check_fits", "check_scene", "neighbour_pairs"]
+__all__ = ["CellGrid", "neighbour_pairs"]
 
 
 def _cells_along(length: float, min_cell: float, periodic: bool, axis: str, what: str) -> int:
@@ -231,80 +231,3 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
     if box.periodic:
         d -= size * np.round(d / size)
     return i, j, d
-
-
-def check_fits(
-    discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE, segments=(), pass_through=frozenset()
-) -> None:
-    """Raise if a disc is outside ``box``, cut by a wall or a segment, or overlaps another.
-
-    Overlaps deeper than ``tolerance`` times the contact distance are errors;
-    touching discs are allowed, and so are overlaps between groups that pass
-    through each other (``pass_through``: sorted group pairs). O(N) with a cell grid.
-
-    Raises:
-        OutsideBoxError: naming the disc, its position and radius (and the segment).
-        OverlapError: naming the deepest overlapping pair and the depth.
-    """
-    pos, rad = discs.positions, discs.radii
-    if len(discs) == 0:
-        return
-    size = box.size
-    if box.periodic:
-        bad = ((pos < 0) | (pos >= size)).any(axis=1)
-        what = "outside the periodic box [0, width) x [0, height)"
-    else:
-        slack = tolerance * rad[:, None]
-        bad = ((pos - rad[:, None] < -slack) | (pos + rad[:, None] > size + slack)).any(axis=1)
-        what = "outside the box or cut by a wall"
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is {what} (box {box.width:g} x {box.height:g})"
-        raise OutsideBoxError(msg)
-    for k, segment in enumerate(segments):
-        cut = segment.distance(pos) < rad * (1.0 - tolerance)
-        if cut.any():
-            i = int(np.flatnonzero(cut)[0])
-            msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is cut by segment {k} {segment!r}"
-            raise OutsideBoxError(msg)
-    i, j, d = neighbour_pairs(pos, 2.0 * float(rad.max()), box)
-    if pass_through:
-        gi, gj = discs.groups[i], discs.groups[j]
-        lo, hi = np.minimum(gi, gj), np.maximum(gi, gj)
-        keep = np.array([(a, b) not in pass_through for a, b in zip(lo.tolist(), hi.tolist())], dtype=bool)
-        i, j, d = i[keep], j[keep], d[keep]
-    contact = rad[i] + rad[j]
-    dist = np.hypot(d[:, 0], d[:, 1])
-    depth = contact - dist
-    bad = depth > tolerance * contact
-    if bad.any():
-        k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
-        msg = (
-            f"discs {min(int(i[k]), int(j[k]))} and {max(int(i[k]), int(j[k]))} overlap by {depth[k]:.6g} "
-            f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
-        )
-        raise OverlapError(msg)
-
-
-def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[tuple[Segment, ...], frozenset]:
-    """Validate what an engine is given: segments, the collision filter, and :func:`check_fits`.
-
-    Returns:
-        ``(segments, pass_through)`` as a tuple of segments and a frozenset of sorted group pairs.
-
-    Raises:
-        TypeError: if a segment is not a :class:`~discsim.state.Segment`.
-        ValueError: if segments are given with a periodic box.
-        OutsideBoxError, OverlapError: from :func:`check_fits`.
-    """
-    segments = tuple(segments)
-    for k, segment in enumerate(segments):
-        if not isinstance(segment, Segment):
-            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
-            raise TypeError(msg)
-    if segments and box.periodic:
-        msg = "segments need a box with walls (periodic=False)"
-        raise InvalidArgumentError(msg)
-    pass_through = normalize_pass_through(pass_through)
-    check_fits(discs, box, segments=segments, pass_through=pass_through)
-    return segments, pass_through

@@ -1,0 +1,23 @@
+"""Thermodynamic measurements of a run: packing fraction, compressibility factor.
+
+Numbers in, numbers out: these read a finished engine (any engine with ``pressure()``,
+``kinetic_energy()`` and ``box``) and know nothing of how it ran.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["compressibility_factor", "packing_fraction"]
+
+
+def packing_fraction(radii: np.ndarray, area: float) -> float:
+    """Fraction of ``area`` covered by discs of ``radii`` ``(N,)``."""
+    return float(math.pi * np.sum(np.asarray(radii, dtype=float) ** 2) / area)
+
+
+def compressibility_factor(sim) -> float:
+    """``Z = P A / (N kT)`` of an event-driven run (``N kT`` is the kinetic energy)."""
+    return sim.pressure() * sim.box.area / sim.kinetic_energy()

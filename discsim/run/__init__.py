@@ -1,0 +1,1 @@
+"""Running engines: the one driver (:mod:`.driver`) and its observers (:mod:`.observers`)."""

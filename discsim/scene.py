@@ -1,0 +1,165 @@
+"""The scene an engine is given: discs, box, segment walls and the collision filter, validated once.
+
+:class:`Scene` checks everything that needs more than one input (every disc inside the box and clear of the
+segments, no overlaps, a well-formed filter) and holds the one definition of the collision filter that every
+engine and every check uses (:meth:`Scene.passes`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from discsim.cells import neighbour_pairs
+from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError
+from discsim.model import OVERLAP_TOLERANCE, Box, Discs, Segment, normalize_pass_through
+
+__all__ = ["Scene", "check_fits", "check_scene", "filter_table"]
+
+
+def filter_table(groups: np.ndarray, pass_through: frozenset) -> tuple[np.ndarray, np.ndarray]:
+    """The collision filter as a table: ``(group, blocked)``.
+
+    ``group`` ``(N,)`` gives each disc's group as an index ``0..G-1`` (its rank
+    among the distinct labels); ``blocked`` ``(G, G)`` bool is True where two
+    groups pass through each other (``pass_through``: sorted label pairs).
+
+    Example:
+        >>> group, blocked = filter_table(np.array([5, 7, 5]), frozenset({(5, 7)}))
+        >>> group.tolist(), blocked.tolist()
+        ([0, 1, 0], [[False, True], [True, False]])
+    """
+    labels = np.unique(groups)
+    group = np.searchsorted(labels, groups).astype(np.int64)
+    names = labels.tolist()
+    blocked = np.array([[(min(g, h), max(g, h)) in pass_through for h in names] for g in names], dtype=bool)
+    return group, blocked.reshape(len(names), len(names))
+
+
+def check_fits(
+    discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE, segments=(), pass_through=frozenset()
+) -> None:
+    """Raise if a disc is outside ``box``, cut by a wall or a segment, or overlaps another.
+
+    Overlaps deeper than ``tolerance`` times the contact distance are errors;
+    touching discs are allowed, and so are overlaps between groups that pass
+    through each other (``pass_through``: sorted group pairs). O(N) with a cell grid.
+
+    Raises:
+        OutsideBoxError: naming the disc, its position and radius (and the segment).
+        OverlapError: naming the deepest overlapping pair and the depth.
+    """
+    pos, rad = discs.positions, discs.radii
+    if len(discs) == 0:
+        return
+    size = box.size
+    if box.periodic:
+        bad = ((pos < 0) | (pos >= size)).any(axis=1)
+        what = "outside the periodic box [0, width) x [0, height)"
+    else:
+        slack = tolerance * rad[:, None]
+        bad = ((pos - rad[:, None] < -slack) | (pos + rad[:, None] > size + slack)).any(axis=1)
+        what = "outside the box or cut by a wall"
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is {what} (box {box.width:g} x {box.height:g})"
+        raise OutsideBoxError(msg)
+    for k, segment in enumerate(segments):
+        cut = segment.distance(pos) < rad * (1.0 - tolerance)
+        if cut.any():
+            i = int(np.flatnonzero(cut)[0])
+            msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is cut by segment {k} {segment!r}"
+            raise OutsideBoxError(msg)
+    i, j, d = neighbour_pairs(pos, 2.0 * float(rad.max()), box)
+    if pass_through:
+        group, blocked = filter_table(discs.groups, pass_through)
+        keep = ~blocked[group[i], group[j]]
+        i, j, d = i[keep], j[keep], d[keep]
+    contact = rad[i] + rad[j]
+    dist = np.hypot(d[:, 0], d[:, 1])
+    depth = contact - dist
+    bad = depth > tolerance * contact
+    if bad.any():
+        k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
+        msg = (
+            f"discs {min(int(i[k]), int(j[k]))} and {max(int(i[k]), int(j[k]))} overlap by {depth[k]:.6g} "
+            f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
+        )
+        raise OverlapError(msg)
+
+
+def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[tuple[Segment, ...], frozenset]:
+    """Validate what an engine is given: segments, the collision filter, and :func:`check_fits`.
+
+    Returns:
+        ``(segments, pass_through)`` as a tuple of segments and a frozenset of sorted group pairs.
+
+    Raises:
+        TypeError: if a segment is not a :class:`~discsim.model.Segment`.
+        ValueError: if segments are given with a periodic box.
+        OutsideBoxError, OverlapError: from :func:`check_fits`.
+    """
+    segments = tuple(segments)
+    for k, segment in enumerate(segments):
+        if not isinstance(segment, Segment):
+            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
+            raise TypeError(msg)
+    if segments and box.periodic:
+        msg = "segments need a box with walls (periodic=False)"
+        raise InvalidArgumentError(msg)
+    pass_through = normalize_pass_through(pass_through)
+    check_fits(discs, box, segments=segments, pass_through=pass_through)
+    return segments, pass_through
+
+
+class Scene:
+    """What an engine simulates, validated once: discs, box, segment walls and the collision filter.
+
+    Args:
+        discs: the :class:`~discsim.model.Discs`.
+        box: the :class:`~discsim.model.Box`.
+        segments: fixed :class:`~discsim.model.Segment` walls (walled boxes only).
+        pass_through: pairs of group labels whose discs pass through each other.
+
+    Attributes:
+        discs, box: as given. segments (tuple[Segment, ...]): as given.
+        pass_through (frozenset[tuple[int, int]]): sorted group pairs.
+        group ((N,) int64): each disc's group as an index into ``blocked``.
+        blocked ((G, G) bool): True where two groups pass through each other.
+
+    Raises:
+        TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
+        InvalidArgumentError: if segments are given with a periodic box.
+        InvalidDiscsError: on a malformed ``pass_through``.
+        OutsideBoxError, OverlapError: if the discs do not fit (see :func:`check_fits`).
+
+    Example:
+        >>> import discsim as ds
+        >>> discs = ds.Discs([[1.0, 1.0], [1.5, 1.0]], [[0.0, 0.0], [0.0, 0.0]], 0.5, groups=[1, 1])
+        >>> scene = Scene(discs, ds.Box(4.0, 2.0), pass_through=[(1, 1)])
+        >>> scene.passes(np.array([0]), np.array([1])).tolist()
+        [True]
+    """
+
+    def __init__(self, discs: Discs, box: Box, segments=(), pass_through=()):
+        if not isinstance(discs, Discs):
+            msg = f"discs must be a discsim.Discs, got {type(discs).__name__}"
+            raise TypeError(msg)
+        if not isinstance(box, Box):
+            msg = f"box must be a discsim.Box, got {type(box).__name__}"
+            raise TypeError(msg)
+        self.segments, self.pass_through = check_scene(discs, box, segments, pass_through)
+        self.discs = discs
+        self.box = box
+        self.group, self.blocked = filter_table(discs.groups, self.pass_through)
+
+    @property
+    def filtering(self) -> bool:
+        """True when some groups pass through each other."""
+        return bool(self.pass_through)
+
+    def passes(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """``(P,)`` bool: True where discs ``i[k]`` and ``j[k]`` pass through each other."""
+        return self.blocked[self.group[i], self.group[j]]
+
+    def __len__(self) -> int:
+        return len(self.discs)

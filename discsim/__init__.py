@@ -17,7 +17,7 @@ from discsim import scenarios
 from discsim.analysis.compare import Comparison, compare
 from discsim.analysis.theory import enskog_collision_rate, henderson_z, speed_cdf, speed_pdf
 from discsim.analysis.thermo import compressibility_factor
-from discsim.engines.event_driven import EventDriven
+from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import POLICIES, FixedStep
 from discsim.errors import (
     BoxTooSmallError,
@@ -34,6 +34,7 @@ from discsim.events import EVENT_DTYPE, Event, EventKind
 from discsim.io.checkpoints import checkpoint_info, load, resume
 from discsim.io.streams import StreamedEvents, read_events, trajectory_from_events
 from discsim.model import Box, Discs, Segment, polygon
+from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
 
 __version__ = "0.1.0"
@@ -48,24 +49,31 @@ def __getattr__(name: str):
     msg = f"module 'discsim' has no attribute {name!r}"
     raise AttributeError(msg)
 
+
 __all__ = [
     "EVENT_DTYPE",
     "POLICIES",
     "Box",
     "BoxTooSmallError",
+    "Callback",
     "CheckpointError",
+    "Checkpointer",
     "Comparison",
     "Discs",
     "DiscsimError",
     "Event",
     "EventDriven",
+    "EventDrivenState",
     "EventKind",
+    "EventStream",
     "FixedStep",
     "InvalidArgumentError",
     "InvalidDiscsError",
+    "Observer",
     "OutsideBoxError",
     "OverlapError",
     "PackingError",
+    "ProgressBar",
     "Scenario",
     "Segment",
     "StreamedEvents",

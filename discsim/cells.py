@@ -16,18 +16,47 @@ import numpy as np
 from discsim.errors import BoxTooSmallError, InvalidArgumentError
 from discsim.model import Box
 
-__all__ = ["CellGrid", "neighbour_pairs"]
+__all__ = ["CellGrid", "grid_shape", "neighbour_pairs"]
 
 
-def _cells_along(length: float, min_cell: float, periodic: bool, axis: str, what: str) -> int:
-    n = max(1, math.floor(length / min_cell * (1 + 1e-12)))
-    if periodic and n < 3:
+def grid_shape(box: Box, min_cell: float, max_cells: int | None = None, what: str | None = None) -> tuple[int, int]:
+    """The one cell-sizing rule: ``(nx, ny)`` cells of at least ``min_cell`` a side over ``box``.
+
+    As many cells as fit along each side (with a relative slack of 1e-12 for
+    roundoff), then fewer, in proportion, where needed to stay under
+    ``max_cells`` (never under 3 a side in a periodic box).
+
+    Args:
+        box: the box. min_cell: the smallest cell side (length units).
+        max_cells: upper bound on ``nx * ny``, or None.
+        what: what ``min_cell`` is; when given, a periodic box with fewer
+            than 3 cells a side raises. When None, such a box gets one cell
+            (every pair of discs is then a candidate neighbour).
+
+    Raises:
+        BoxTooSmallError: see ``what``.
+
+    Example:
+        >>> grid_shape(Box(10.0, 4.0), 1.0), grid_shape(Box(10.0, 4.0), 1.0, max_cells=10)
+        ((10, 4), (5, 2))
+    """
+    nx = max(1, math.floor(box.width / min_cell * (1 + 1e-12)))
+    ny = max(1, math.floor(box.height / min_cell * (1 + 1e-12)))
+    if box.periodic and min(nx, ny) < 3:
+        if what is None:
+            return 1, 1
+        axis, length = ("x", box.width) if nx < 3 else ("y", box.height)
         msg = (
             f"periodic box {axis}-extent {length:g} is too small for its cell grid: it needs at "
             f"least 3 cells of side >= {min_cell:g} ({what}), i.e. >= {3 * min_cell:g}"
         )
         raise BoxTooSmallError(msg)
-    return n
+    if max_cells is not None and nx * ny > max_cells:
+        scale = math.sqrt(nx * ny / max_cells)
+        floor_n = 3 if box.periodic else 1
+        nx = max(floor_n, int(nx / scale))
+        ny = max(floor_n, int(ny / scale))
+    return nx, ny
 
 
 class CellGrid:
@@ -64,13 +93,7 @@ class CellGrid:
         if not (min_cell_size > 0 and math.isfinite(min_cell_size)):
             msg = f"min_cell_size must be positive and finite, got {min_cell_size!r}"
             raise InvalidArgumentError(msg)
-        nx = _cells_along(box.width, min_cell_size, box.periodic, "x", what)
-        ny = _cells_along(box.height, min_cell_size, box.periodic, "y", what)
-        if max_cells is not None and nx * ny > max_cells:
-            scale = math.sqrt(nx * ny / max_cells)
-            floor_n = 3 if box.periodic else 1
-            nx = max(floor_n, int(nx / scale))
-            ny = max(floor_n, int(ny / scale))
+        nx, ny = grid_shape(box, min_cell_size, max_cells, what)
         self.box = box
         self.nx, self.ny = nx, ny
         self.lx, self.ly = box.width / nx, box.height / ny
@@ -78,16 +101,6 @@ class CellGrid:
 
     def __len__(self) -> int:
         return self.nx * self.ny
-
-    def cell_index(self, cx: int, cy: int) -> int:
-        """Flat index of cell column ``cx``, row ``cy``."""
-        return cx * self.ny + cy
-
-    def cell_of(self, x: float, y: float) -> int:
-        """Flat index of the cell holding point ``(x, y)`` (clamped to the grid)."""
-        cx = min(max(int(x / self.lx), 0), self.nx - 1)
-        cy = min(max(int(y / self.ly), 0), self.ny - 1)
-        return cx * self.ny + cy
 
     def cells_of(self, positions: np.ndarray) -> np.ndarray:
         """Flat cell index ``(N,)`` of each row of ``positions`` ``(N, 2)``."""
@@ -175,20 +188,9 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
     empty = np.zeros(0, dtype=np.int64)
     if n < 2:
         return empty, empty, np.zeros((0, 2))
-    size = box.size
-    if box.periodic:
-        nx = max(1, int(box.width // cell_size))
-        ny = max(1, int(box.height // cell_size))
-        if nx < 3 or ny < 3:  # tiny periodic box: every pair is a candidate
-            nx = ny = 1
-    else:
-        nx = max(1, int(box.width // cell_size))
-        ny = max(1, int(box.height // cell_size))
-    max_cells = max(4 * n, 1 << 16)  # bounds the cell-start table when few points share a large box
-    if nx * ny > max_cells:
-        scale = math.sqrt(nx * ny / max_cells)
-        floor_n = 3 if box.periodic else 1
-        nx, ny = max(floor_n, int(nx / scale)), max(floor_n, int(ny / scale))
+    # At most max(4 N, 65536) cells bounds the cell-start table when few points share a large box;
+    # a tiny periodic box gets one cell, and every pair is a candidate.
+    nx, ny = grid_shape(box, cell_size, max(4 * n, 1 << 16))
     cx = np.clip((positions[:, 0] * (nx / box.width)).astype(np.int64), 0, nx - 1)
     cy = np.clip((positions[:, 1] * (ny / box.height)).astype(np.int64), 0, ny - 1)
     cell = cx * ny + cy
@@ -227,7 +229,4 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
         return empty, empty, np.zeros((0, 2))
     i = np.concatenate(parts_i)
     j = np.concatenate(parts_j)
-    d = positions[j] - positions[i]
-    if box.periodic:
-        d -= size * np.round(d / size)
-    return i, j, d
+    return i, j, box.minimum_image(positions[j] - positions[i])

@@ -55,6 +55,7 @@ def event_from_record(record) -> Event:
     """The :class:`Event` of one row of an :data:`EVENT_DTYPE` array."""
     return Event(float(record["time"]), KIND_NAMES[int(record["kind"])], int(record["i"]), int(record["j"]))
 
+
 #: One event: time, kind (0 disc-disc, 1 wall), discs ``i`` and ``j`` (``j`` is
 #: -1 for a wall hit), and each disc's position and velocity after the event
 #: (NaN for the absent ``j``).
@@ -100,20 +101,22 @@ class EventLog:
         """Append records given as a structured array of :data:`EVENT_DTYPE`."""
         self._rows.extend(tuple(r) for r in records.tolist())
 
-    def drain(self) -> np.ndarray:
-        """Return every record as a structured array ``(E,)`` and empty the log.
+    def since(self, start: int) -> np.ndarray:
+        """The records from index ``start`` on, as a structured array (the log is unchanged).
 
-        Used to stream a long run's log to disk in chunks so that memory stays flat.
+        The driver hands such slices to the observers of a run.
 
         Example:
             >>> log = EventLog()
             >>> log.wall(0.5, 3, 1.0, 2.0, -1.0, 0.0)
-            >>> log.drain()["i"].tolist(), len(log)
-            ([3], 0)
+            >>> log.since(0)["i"].tolist(), log.since(1).shape
+            ([3], (0,))
         """
-        records = np.array(self._rows, dtype=EVENT_DTYPE)
-        del self._rows[:]  # in place: a caller may hold the list's bound methods
-        return records
+        return np.array(self._rows[start:], dtype=EVENT_DTYPE)
+
+    def clear(self) -> None:
+        """Drop every record (in place: a caller may hold the list's bound methods)."""
+        del self._rows[:]
 
     def __len__(self) -> int:
         return len(self._rows)

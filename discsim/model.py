@@ -213,11 +213,24 @@ class Box:
         return np.where(wrapped >= size, 0.0, wrapped)  # mod of a tiny negative number rounds up to the size
 
     def displacement(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """``b - a``, with the minimum-image convention when periodic."""
-        d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
-        if self.periodic:
-            d = d - self.size * np.round(d / self.size)
-        return d
+        """``b - a``, with the minimum-image convention when periodic.
+
+        Example:
+            >>> Box(10.0, 10.0, periodic=True).displacement([9.0, 1.0], [1.0, 2.0]).tolist()
+            [2.0, 1.0]
+        """
+        return self.minimum_image(np.asarray(b, dtype=float) - np.asarray(a, dtype=float))
+
+    def minimum_image(self, d: np.ndarray) -> np.ndarray:
+        """Displacements ``d`` ``(..., 2)`` mapped to their nearest periodic image (unchanged with walls).
+
+        The one minimum-image rule: ``d - size * round(d / size)``, element by
+        element. The scalar hot loops inline the same formula.
+        """
+        if not self.periodic:
+            return d
+        size = self.size
+        return d - size * np.round(d / size)
 
 
 class Segment:

@@ -39,9 +39,8 @@ class EventQueue:
     """
 
     #: Sublist size of the SortedList (its default is 1000). Smaller sublists make
-    #: the insertions and deletions at the front cheaper: 5-9% more collisions per
-    #: second at N = 10^4 in an A/B run, no change at 10^5. ``SortedList._reset`` is
-    #: the documented way to set it.
+    #: the insertions and deletions at the front cheaper (measured in
+    #: docs/performance.md). ``SortedList._reset`` is the documented way to set it.
     LOAD = 100
 
     def __init__(self, n_owners: int):
@@ -268,7 +267,7 @@ class CalendarEventQueue:
         (2, (0.5, 0, 'c'))
     """
 
-    #: Target number of events per bin. 32 to 128 measured alike (within noise); fewer bins help at 10^5.
+    #: Target number of events per bin (32 to 128 measured alike; see docs/performance.md).
     PER_BIN = 64
     #: Lap length in pops per live event: 2 to 4 measured alike; shorter laps re-bin more often.
     SPAN = 3.0

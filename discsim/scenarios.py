@@ -73,9 +73,7 @@ def _sites(n: int, side: float, radius: float, periodic: bool, rows: int, exact:
     y = y0 + jj * ay
     sites = np.column_stack([x.ravel(), y.ravel()])
     if exact:  # the nearest pair of sites, images across a periodic edge included
-        gap = sites[:, None, :] - sites[None, :, :]
-        if periodic:
-            gap -= side * np.round(gap / side)
+        gap = Box(side, side, periodic).minimum_image(sites[:, None, :] - sites[None, :, :])
         distance = np.hypot(gap[..., 0], gap[..., 1])
         np.fill_diagonal(distance, np.inf)
         return sites, float(distance.min()) if len(sites) > 1 else math.inf

@@ -9,7 +9,29 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["reconstruct"]
+from discsim.errors import TimeError
+
+__all__ = ["check_times", "positions_from_log", "reconstruct"]
+
+
+def check_times(times, start: float, end: float, span: str) -> np.ndarray:
+    """``times`` as a float array ``(T,)``, checked to be finite and within ``[start, end]``.
+
+    The span is widened by ``1e-12 * max(1, |end|)`` for roundoff.
+
+    Raises:
+        TimeError: naming the first bad time and the ``span`` ("simulated span", "logged span").
+    """
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    if times.size and not np.isfinite(times).all():
+        msg = f"trajectory times must be finite, got {times[~np.isfinite(times)][0]!r}"
+        raise TimeError(msg)
+    tol = 1e-12 * max(1.0, abs(end))
+    if times.size and (times.min() < start - tol or times.max() > end + tol):
+        bad = times.min() if times.min() < start - tol else times.max()
+        msg = f"trajectory time {bad!r} is outside the {span} [{start!r}, {end!r}]"
+        raise TimeError(msg)
+    return times
 
 
 def reconstruct(
@@ -19,6 +41,8 @@ def reconstruct(
     time0: float,
     times,
     box=None,
+    *,
+    unwrapped: bool = False,
 ) -> np.ndarray:
     """Exact positions of every disc at ``times`` from an initial state and a log.
 
@@ -27,7 +51,12 @@ def reconstruct(
         positions0, velocities0: ``(N, 2)`` state at ``time0``.
         time0: start time of the log.
         times: ``(T,)`` times (any order) at or after ``time0``.
-        box: if given and periodic, positions are wrapped into it.
+        box: if given and periodic, positions are wrapped into it
+            (:meth:`~discsim.model.Box.wrap`), unless ``unwrapped``.
+        unwrapped: follow each disc across the periodic edges: where a
+            logged position differs from the straight flight since the disc's
+            previous record by whole box lengths (the engine wrapped it in
+            between), those lengths are added back, exactly.
 
     Returns:
         ``(T, N, 2)`` positions. An event exactly at a requested time counts as
@@ -60,6 +89,9 @@ def reconstruct(
     order = np.lexsort((seq, t_rec, disc))  # by disc, then time, then log order
     disc, t_rec, state = disc[order], t_rec[order], state[order]
     starts = np.searchsorted(disc, np.arange(n + 1))
+    periodic = box is not None and box.periodic
+    if unwrapped and periodic and len(state) > n:
+        state[:, :2] += _image_shifts(disc, t_rec, state, starts, box.size)
     out = np.empty((len(times), n, 2))
     for d in range(n):
         lo, hi = starts[d], starts[d + 1]
@@ -67,6 +99,30 @@ def reconstruct(
         k = np.maximum(k, lo)
         dt = (times - t_rec[k])[:, None]
         out[:, d, :] = state[k, :2] + state[k, 2:] * dt
-    if box is not None and box.periodic:
-        out = np.mod(out, box.size)
+    if periodic and not unwrapped:
+        out = box.wrap(out)
     return out
+
+
+def _image_shifts(disc, t_rec, state, starts, size) -> np.ndarray:
+    """``(R, 2)`` whole box lengths to add to each record so that every disc's path is continuous.
+
+    Records are sorted by disc, then time. Between two records of a disc it flies straight, so the
+    later logged position differs from the earlier one's flight by whole box lengths plus roundoff.
+    """
+    flown = state[:-1, :2] + state[:-1, 2:] * (t_rec[1:] - t_rec[:-1])[:, None]
+    jump = np.round((flown - state[1:, :2]) / size) * size
+    jump[np.isin(np.arange(1, len(state)), starts)] = 0.0  # the first record of the next disc
+    shifts = np.zeros_like(state[:, :2])
+    shifts[1:] = np.cumsum(jump, axis=0)
+    first = np.repeat(shifts[starts[:-1]], np.diff(starts), axis=0)  # each disc starts from zero
+    return shifts - first
+
+
+def positions_from_log(events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool):
+    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` at ``start_time``.
+
+    Checks ``times`` first (:func:`check_times`, naming the ``span``). Returns positions ``(T, N, 2)``.
+    """
+    times = check_times(times, start_time, end_time, span)
+    return reconstruct(events, discs.positions, discs.velocities, start_time, times, box, unwrapped=unwrapped)

@@ -46,15 +46,15 @@ def _assert_same(a, b):
     assert a.counts == b.counts
     assert a.max_overlap == b.max_overlap
     assert a.max_queue == b.max_queue
-    assert a._virial == b._virial
+    assert a.state().virial == b.state().virial
     if a.time > 0:
         assert a.pressure() == b.pressure()
 
 
 def _state_bytes(sim) -> bytes:
     """Every array of the engine's internal state, as bytes (clocks, cells, queue...)."""
-    state = sim._get_state()
-    return b"".join(v.tobytes() for k, v in sorted(state.items()) if isinstance(v, np.ndarray))
+    scalars, arrays = sim.state().to_arrays()
+    return repr(sorted(scalars.items())).encode() + b"".join(v.tobytes() for _, v in sorted(arrays.items()))
 
 
 # --- save / load -----------------------------------------------------------------------
@@ -218,13 +218,15 @@ def test_periodic_checkpoints_are_taken_every_k_events_and_at_the_end(tmp_path, 
     discs, box = ds.random_gas(100, 0.5, seed=8)
     sim = ds.EventDriven(discs, box, record=False)
     taken = []
-    original = ds.EventDriven._write_checkpoint
+    from discsim.run import observers
 
-    def spy(self, path, writer, recording, run):
-        taken.append((self._physical(), run["finished"]))
-        original(self, path, writer, recording, run)
+    original = observers.write_checkpoint
 
-    monkeypatch.setattr(ds.EventDriven, "_write_checkpoint", spy)
+    def spy(engine, path, *, run, record):
+        taken.append((engine._units(), run["finished"]))
+        original(engine, path, run=run, record=record)
+
+    monkeypatch.setattr(observers, "write_checkpoint", spy)
     sim.run(events=2500, checkpoint=tmp_path / "c.dsc", checkpoint_every=1000)
     assert taken == [(0, False), (1000, False), (2000, False), (2500, True)]
     info = ds.checkpoint_info(tmp_path / "c.dsc")
@@ -238,17 +240,19 @@ class _Crash(Exception):
 def _crash_after(monkeypatch, flushes: int, garbage: bytes = b""):
     """Make the ``flushes``-th write to the streamed log append ``garbage`` (half a chunk) and die."""
     calls = {"n": 0}
-    original = ds.EventDriven._flush_stream
+    from discsim.run.observers import EventStream
 
-    def flaky(self, writer):
+    original = EventStream.flush
+
+    def flaky(self, engine):
         calls["n"] += 1
         if calls["n"] == flushes:
-            writer._handle.write(garbage)
-            writer._handle.flush()
+            self._writer._handle.write(garbage)
+            self._writer._handle.flush()
             raise _Crash
-        original(self, writer)
+        original(self, engine)
 
-    monkeypatch.setattr(ds.EventDriven, "_flush_stream", flaky)
+    monkeypatch.setattr(EventStream, "flush", flaky)
 
 
 @pytest.mark.parametrize("record", [True, False])
@@ -488,13 +492,13 @@ def test_record_streams_refuse_what_they_cannot_hold(tmp_path):
 
 def test_save_load_of_a_renumbered_system_continues_bit_for_bit(tmp_path):
     """Large systems are numbered internally tile by tile; a checkpoint keeps that numbering."""
-    from discsim.engines.event_driven.engine import _RENUMBER_MIN
+    from discsim.engines.event_driven.python.backend import _RENUMBER_MIN
 
     discs, box = ds.random_gas(_RENUMBER_MIN + 500, 0.3, periodic=False, seed=8)
     shuffled = np.random.default_rng(1).permutation(len(discs))
     discs = ds.Discs(discs.positions[shuffled], discs.velocities[shuffled], discs.radii, discs.masses)
     a = ds.EventDriven(discs, box).run(events=3000)
-    assert a._rank is not None  # the internal numbering is not the caller's
+    assert not np.array_equal(a.state().order, np.arange(len(discs)))  # the internal numbering is not the caller's
     b = ds.load(a.save(tmp_path / "big.dsc"))
     assert _state_bytes(a) == _state_bytes(b)
     a.run(events=3000)

@@ -153,7 +153,7 @@ def test_calendar_queue_matches_the_sorted_queue_over_many_laps_and_epoch_moves(
     runs = []
     for queue in ("sorted", "calendar"):
         sim = ds.EventDriven(discs, box, queue=queue, record=False)
-        sim._rebase_every = 3001  # forces shift_times on the queue every 3001 physical events
+        sim._backend._rebase_every = 3001  # forces shift_times on the queue every 3001 physical events
         sim.run(events=40_000)
         runs.append(sim)
     a, b = runs
@@ -243,7 +243,7 @@ def test_moving_the_clock_epoch_keeps_the_physics_and_determinism():
     # Rebase the internal clock every 7 physical events instead of every 2^18.
     discs, box = ds.random_gas(40, 0.5, seed=9, periodic=False)
     often = ds.EventDriven(discs, box)
-    often._rebase_every = 7
+    often._backend._rebase_every = 7
     just_collided = set()
     for _ in range(300):  # the oracle, from the engine's state, agrees event by event
         t0 = often.time
@@ -253,13 +253,13 @@ def test_moving_the_clock_epoch_keeps_the_physics_and_determinism():
         assert (event.kind, {event.i, event.j}) == (kind, {i, j})
         just_collided = {frozenset((i, j))} if kind == "collision" else set()
     often._check()
-    assert often._epoch > 0.5 * often.time > 0  # the epoch did move
+    assert often.state().epoch > 0.5 * often.time > 0  # the epoch did move
     # splitting a run does not move the epoch differently
     whole = ds.EventDriven(discs, box)
-    whole._rebase_every = 37
+    whole._backend._rebase_every = 37
     whole.run(until=20.0)
     halves = ds.EventDriven(discs, box)
-    halves._rebase_every = 37
+    halves._backend._rebase_every = 37
     halves.run(until=7.3).run(until=20.0)
     assert whole.time == halves.time == 20.0
     assert halves.events.tobytes() == whole.events.tobytes()
@@ -272,13 +272,13 @@ def test_moving_the_clock_epoch_keeps_the_physics_and_determinism():
 def test_restoring_state_across_epoch_moves_is_bit_for_bit():
     discs, box = ds.random_gas(50, 0.4, seed=10)
     a = ds.EventDriven(discs, box)
-    a._rebase_every = 11
+    a._backend._rebase_every = 11
     a.run(until=3.0)
-    b = ds.EventDriven._from_state(discs, box, a._get_state())
-    b._rebase_every = 11
+    b = ds.EventDriven._restore(a.scene, a._settings(), a.state(), a.events, a.start_time)
+    b._backend._rebase_every = 11
     a.run(until=9.0)
     b.run(until=9.0)
-    assert a._epoch > 0 and a._epoch == b._epoch
+    assert a.state().epoch > 0 and a.state().epoch == b.state().epoch
     assert a.events.tobytes() == b.events.tobytes()
     assert np.array_equal(a.positions, b.positions)
 
@@ -312,7 +312,7 @@ def test_run_leaves_the_garbage_collector_as_it_found_it():
 def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
     """Each cell's getter, applied to its tile, returns the members of the grid's 3x3 block, in order."""
     from discsim.cells import CellGrid
-    from discsim.engines.event_driven.engine import _TILE, _tile_cells
+    from discsim.engines.event_driven.python.backend import _TILE, _tile_cells
 
     nx, ny = shape
     grid = CellGrid(ds.Box(float(nx), float(ny), periodic=periodic), 1.0)
@@ -331,7 +331,7 @@ def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
 
 def test_cell_crossings_keep_ghost_copies_in_step():
     """After many crossings in a box of several tiles, every ghost copy is the cell's own tuple (``_check``)."""
-    from discsim.engines.event_driven.engine import _TILE
+    from discsim.engines.event_driven.python.backend import _TILE
 
     discs, box = ds.random_gas(1500, 0.3, periodic=True, seed=4)
     sim = ds.EventDriven(discs, box, record=False)
@@ -344,8 +344,8 @@ def test_cell_crossings_keep_ghost_copies_in_step():
 # --- the internal numbering of large systems -------------------------------------------------
 def test_the_internal_numbering_is_invisible(monkeypatch):
     """A large system numbered tile by tile inside gives the caller the same positions, events and ids."""
-    from discsim.engines.event_driven.engine import _RENUMBER_MIN
-    from discsim.engines.event_driven import engine as event_driven
+    from discsim.engines.event_driven.python import backend
+    from discsim.engines.event_driven.python.backend import _RENUMBER_MIN
 
     gas, box = ds.random_gas(_RENUMBER_MIN + 904, 0.3, periodic=True, seed=5)
     n = len(gas)
@@ -353,13 +353,13 @@ def test_the_internal_numbering_is_invisible(monkeypatch):
     masses = np.linspace(1.0, 2.0, n)  # unequal, so that a mix-up of masses would show
     discs = ds.Discs(gas.positions[shuffled], gas.velocities[shuffled], gas.radii, masses)
     sim = ds.EventDriven(discs, box)
-    order = sim._order
-    assert sim._rank is not None and sorted(order.tolist()) == list(range(n))
+    order = sim.state().order
+    assert not np.array_equal(order, np.arange(n)) and sorted(order.tolist()) == list(range(n))
     assert np.abs(np.diff(order)).mean() > n / 10  # far from the identity on a shuffled input
     assert np.array_equal(sim.positions, discs.positions) and np.array_equal(sim.velocities, discs.velocities)
-    monkeypatch.setattr(event_driven, "_RENUMBER_MIN", 10 * n)
+    monkeypatch.setattr(backend, "_RENUMBER_MIN", 10 * n)
     plain = ds.EventDriven(discs, box)  # the caller's numbering inside too
-    assert plain._rank is None
+    assert np.array_equal(plain.state().order, np.arange(n))
     first = [sim.step() for _ in range(2000)]
     second = [plain.step() for _ in range(2000)]
     for a, b in zip(first, second):
@@ -377,7 +377,7 @@ def test_the_internal_numbering_is_invisible(monkeypatch):
 def test_small_systems_keep_the_callers_numbering():
     discs, box = ds.random_gas(500, 0.3, seed=2)
     sim = ds.EventDriven(discs, box)
-    assert sim._rank is None and np.array_equal(sim._order, np.arange(500))
+    assert np.array_equal(sim.state().order, np.arange(500))
 
 
 # --- runs with no time limit end when nothing can ever happen again -----------------------------------

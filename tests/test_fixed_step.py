@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import discsim as ds
-from discsim.engines.fixed_step import engine as fixed_step
+from discsim.engines.fixed_step import broad_phase
 from discsim.errors import BoxTooSmallError, OutsideBoxError, OverlapError, TimeError
 from discsim.events import Event
 
@@ -182,7 +182,7 @@ def test_all_pairs_and_grid_give_identical_runs(seed, policy, periodic):
 def test_all_pairs_in_blocks_gives_the_same_run(monkeypatch):
     discs, box = ds.random_gas(90, 0.4, seed=3)
     whole = ds.FixedStep(discs, box, frame_rate=6.0, broad_phase="all-pairs").run(frames=10)
-    monkeypatch.setattr(fixed_step, "_ALL_PAIRS_BLOCK", 500)  # about 6 rows per block
+    monkeypatch.setattr(broad_phase, "_ALL_PAIRS_BLOCK", 500)  # about 6 rows per block
     blocks = ds.FixedStep(discs, box, frame_rate=6.0, broad_phase="all-pairs").run(frames=10)
     assert_logs_equal(whole.events, blocks.events)
     assert whole.counts == blocks.counts

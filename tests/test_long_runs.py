@@ -24,7 +24,7 @@ def test_hundred_thousand_collisions_at_packing_fraction_0_7():
     while sim.counts["collisions"] < 100_000:
         sim.run(events=10_000)
         deepest = max(deepest, _deepest_overlap(sim))
-        assert len(sim._queue) <= n
+        assert sim.queue_size <= n
     assert abs(sim.kinetic_energy() / e0 - 1) < 1e-12
     assert np.abs(sim.momentum() - p0).max() < 1e-9
     assert deepest < 1e-9

@@ -287,9 +287,7 @@ def _max_overlap(positions: np.ndarray, radii: np.ndarray, box) -> float:
     contact = radii[ii] + radii[jj]
     block = max(1, 2_000_000 // len(ii))
     for start in range(0, len(positions), block):
-        d = positions[start : start + block, jj] - positions[start : start + block, ii]
-        if box.periodic:
-            d -= box.size * np.round(d / box.size)
+        d = box.minimum_image(positions[start : start + block, jj] - positions[start : start + block, ii])
         depth = 1.0 - np.hypot(d[..., 0], d[..., 1]) / contact
         deepest = max(deepest, float(depth.max()))
     return deepest
@@ -435,9 +433,7 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     times = times[(times >= start) & (times <= horizon)]
     pos_t = truth.trajectory(times)
     pos_a = approx.trajectory(times)
-    d = pos_a - pos_t
-    if truth.box.periodic:
-        d -= truth.box.size * np.round(d / truth.box.size)
+    d = truth.box.minimum_image(pos_a - pos_t)
     dist = np.hypot(d[..., 0], d[..., 1]) if n else np.zeros((len(times), 0))
     per_time = dist.max(axis=1) if n else np.zeros(len(times))
     radii = truth.discs.radii

@@ -1,11 +1,14 @@
-"""Checkpoints: load a saved simulation, and resume a run that was interrupted.
+"""Checkpoints of every engine, both directions: save, load, resume, and what a file holds.
 
-A checkpoint is a state file (:mod:`discsim.io`: one JSON document plus named
-numpy arrays, a SHA-256 checksum and a format version, written atomically)
-made by ``EventDriven.save(path)`` or by ``run(checkpoint=path, ...)``. It
-holds the initial discs, the box, the time, the counters, the settings, the
-event queue and per-disc clocks, and the event log or where it was streamed.
-No pickle is involved: loading a file never runs code from it.
+A checkpoint is a state file (:mod:`discsim.io.container`: one JSON document plus named numpy arrays, a
+SHA-256 checksum, written atomically) made by ``sim.save(path)`` or by ``run(checkpoint=path, ...)``. It
+holds the scene (initial discs, box, segments, collision filter), the engine's settings, its public run
+state (``sim.state()``: an :class:`~discsim.engines.base.EngineState` of arrays and scalars), and the event
+log or where it was streamed. No pickle: loading a file never runs code from it.
+
+Layouts: ``layout`` 2 (this one) stores the state's fields by name under ``state.``; files written before
+it (an event-driven engine's private arrays, in its internal numbering) are read and converted, and
+continue bit for bit.
 
 Typical use::
 
@@ -17,16 +20,75 @@ Typical use::
 
 from __future__ import annotations
 
+import uuid
 from pathlib import Path
 
-from discsim.engines.event_driven import EventDriven
-from discsim.errors import CheckpointError, DiscsimError
-from discsim.io.container import read_state
+import numpy as np
 
-__all__ = ["checkpoint_info", "load", "resume"]
+from discsim.engines.event_driven import EventDriven, EventDrivenState
+from discsim.engines.fixed_step import FixedStep
+from discsim.errors import CheckpointError, DiscsimError
+from discsim.events import EVENT_DTYPE
+from discsim.io.container import read_state, write_state
+from discsim.model import Box, Discs, Segment
+from discsim.scene import Scene
+
+__all__ = ["checkpoint_info", "load", "resume", "save", "write_checkpoint"]
 
 #: Engines a checkpoint can hold, by the name stored in the file.
-_ENGINES = {"EventDriven": EventDriven}
+ENGINES = {"EventDriven": EventDriven, "FixedStep": FixedStep}
+#: The layout of the JSON document and the arrays written by this version.
+LAYOUT = 2
+
+
+def save(engine, path) -> Path:
+    """Write ``engine``'s whole state to ``path`` (see ``Engine.save``); return the path."""
+    return write_checkpoint(engine, Path(path), run=None, record=engine.record)
+
+
+def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
+    """Write a checkpoint of ``engine`` to ``path``, atomically.
+
+    Args:
+        engine: any discsim engine.
+        path: the file (its folder must exist); replaced if present.
+        run: the goal of the ``run()`` call writing it (see :func:`checkpoint_info`), or None for ``save()``.
+        record: the engine's own ``record`` setting (a streaming run records meanwhile).
+    """
+    if engine._run_id is None:
+        engine._run_id = uuid.uuid4().hex
+    scalars, arrays = engine.state().to_arrays()
+    discs, box, scene = engine.discs, engine.box, engine.scene
+    meta = {
+        "layout": LAYOUT,
+        "engine": type(engine).__name__,
+        "run_id": engine._run_id,
+        "start_time": engine.start_time,
+        "time": engine.time,
+        "counts": dict(engine.counts),
+        "box": {"width": box.width, "height": box.height, "periodic": box.periodic},
+        "scene": {
+            "segments": [[*s.p0.tolist(), *s.p1.tolist()] for s in scene.segments],
+            "pass_through": sorted(scene.pass_through),
+        },
+        "settings": {**engine._settings(), "record": record},
+        "state_version": engine.STATE.VERSION,
+        "state": scalars,
+        "stream": engine._stream,
+        "run": run,
+    }
+    out = {f"state.{name}": value for name, value in arrays.items()}
+    out["events"] = engine._log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
+    out.update(
+        {
+            "discs.positions": discs.positions,
+            "discs.velocities": discs.velocities,
+            "discs.radii": discs.radii,
+            "discs.masses": discs.masses,
+            "discs.groups": discs.groups,
+        }
+    )
+    return write_state(Path(path), meta, out)
 
 
 def checkpoint_info(path) -> dict:
@@ -36,8 +98,8 @@ def checkpoint_info(path) -> dict:
         A dict with ``engine``, ``n`` (discs), ``time``, ``counts`` (collisions,
         wall hits, ...), ``run_id``, ``stream`` (where the log was streamed, or
         None) and ``run`` (the goal of the ``run()`` call that wrote it:
-        ``until``, ``events`` (total physical events), ``checkpoint_every``,
-        ``record_to``, ``finished``; None for a file from ``save()``).
+        ``until``, ``events`` (total units of work: physical events, or frames),
+        ``checkpoint_every``, ``record_to``, ``finished``; None for a file from ``save()``).
 
     Raises:
         FileNotFoundError: if there is no such file.
@@ -53,14 +115,18 @@ def checkpoint_info(path) -> dict:
         ('EventDriven', 30, 0.5, None)
     """
     meta, arrays = read_state(path)
-    _check_engine(meta, path)
+    _engine_class(meta, path)
     try:
-        scalars = meta["state"]["scalars"]
-        counts = {k: scalars[k] for k in ("collisions", "wall_hits", "cell_crossings", "stale", "predictions")}
+        if meta.get("layout") == LAYOUT:
+            time, counts = meta["time"], meta["counts"]
+        else:  # the first layout
+            scalars = meta["state"]["scalars"]
+            time = scalars["time"]
+            counts = {k: scalars[k] for k in ("collisions", "wall_hits", "cell_crossings", "stale", "predictions")}
         return {
             "engine": meta["engine"],
             "n": len(arrays["discs.radii"]),
-            "time": scalars["time"],
+            "time": time,
             "counts": counts,
             "run_id": meta["run_id"],
             "stream": meta["stream"],
@@ -71,15 +137,15 @@ def checkpoint_info(path) -> dict:
         raise CheckpointError(msg) from exc
 
 
-def _check_engine(meta, path) -> type:
+def _engine_class(meta, path) -> type:
     engine = meta.get("engine") if isinstance(meta, dict) else None
-    if engine not in _ENGINES:
-        msg = f"{path}: not a discsim checkpoint (engine {engine!r}; known: {sorted(_ENGINES)})"
+    if engine not in ENGINES:
+        msg = f"{path}: not a discsim checkpoint (engine {engine!r}; known: {sorted(ENGINES)})"
         raise CheckpointError(msg)
-    return _ENGINES[engine]
+    return ENGINES[engine]
 
 
-def load(path) -> EventDriven:
+def load(path):
     """Load a simulation saved by ``save(path)`` or by ``run(checkpoint=path)``.
 
     The loaded engine continues exactly as the saved one would have: the same
@@ -91,7 +157,7 @@ def load(path) -> EventDriven:
         path: the checkpoint file.
 
     Returns:
-        The engine, at the saved time.
+        The engine (:class:`~discsim.EventDriven` or :class:`~discsim.FixedStep`), at the saved time.
 
     Raises:
         FileNotFoundError: if there is no such file.
@@ -108,19 +174,120 @@ def load(path) -> EventDriven:
         (True, True, 'heap')
     """
     meta, arrays = read_state(path)
-    engine = _check_engine(meta, path)
+    engine = _engine_class(meta, path)
     try:
-        return engine._from_saved(meta, arrays)
-    except (KeyError, TypeError, IndexError, DiscsimError) as exc:
+        discs = Discs(
+            arrays["discs.positions"],
+            arrays["discs.velocities"],
+            arrays["discs.radii"],
+            arrays["discs.masses"],
+            arrays["discs.groups"],
+        )
+        box = Box(**meta["box"])
+        if meta.get("layout") == LAYOUT:
+            scene_meta, settings = meta["scene"], meta["settings"]
+            state = engine.STATE.from_arrays(
+                meta["state"],
+                {k.removeprefix("state."): v for k, v in arrays.items() if k.startswith("state.")},
+                meta["state_version"],
+            )
+            events = arrays["events"]
+        else:
+            scene_meta, settings, state, events = _first_layout(meta, arrays)
+        segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
+        scene = Scene(discs, box, segments, [tuple(pair) for pair in scene_meta.get("pass_through", [])])
+        sim = engine._restore(scene, settings, state, events, float(meta["start_time"]))
+    except (KeyError, TypeError, IndexError, ValueError, DiscsimError) as exc:
         msg = f"{path}: the checkpoint is incomplete or inconsistent ({type(exc).__name__}: {exc})"
         raise CheckpointError(msg) from exc
+    sim._run_id = meta["run_id"]
+    sim._stream = meta["stream"]
+    return sim
 
 
-def resume(path, *, progress: bool = False, record_to=None) -> EventDriven:
+def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenState, np.ndarray]:
+    """``(scene, settings, state, events)`` from a file of the first layout (event-driven engines only).
+
+    That layout stored the engine's private lists by attribute name, in its internal numbering (``order``;
+    files older still used the caller's numbering throughout), and each queued event's payload as
+    ``(kind, other, stamp)``.
+    """
+    old = dict(meta["state"])
+    old.update({k.removeprefix("state."): v for k, v in arrays.items() if k.startswith("state.")})
+    scalars, settings = old["scalars"], old["settings"]
+    n = len(arrays["discs.radii"])
+    order = np.asarray(old.get("order", np.arange(n)), dtype=np.int64)
+
+    def caller(values) -> np.ndarray:  # per-disc values in internal numbering -> caller's numbering
+        values = np.asarray(values)
+        out = np.empty_like(values)
+        out[order] = values
+        return out
+
+    def ids(values) -> np.ndarray:  # internal disc numbers -> the caller's (-1 stays -1)
+        values = np.asarray(values, dtype=np.int64)
+        return np.where(values >= 0, order[np.maximum(values, 0)], values)
+
+    payload = np.asarray(old["queue_payload"], dtype=np.int64).reshape(-1, 3)
+    kinds = payload[:, 0]
+    members, sizes = old["cell_members"], old["cell_sizes"]
+    last = scalars["last"]
+    box = Box(**meta["box"])
+    from discsim.cells import CellGrid
+
+    diameter = 2.0 * float(np.max(arrays["discs.radii"])) if n else 1.0
+    cell_size = settings["cell_size"]
+    grid = (
+        CellGrid(box, diameter, max_cells=4 * n + 9)
+        if cell_size is None
+        else CellGrid(box, float(cell_size), what="the cell_size asked for")
+    )
+    state = EventDrivenState(
+        time=scalars["time"],
+        epoch=scalars.get("epoch", 0.0),
+        since_rebase=scalars.get("since_rebase", 0),
+        collisions=scalars["collisions"],
+        wall_hits=scalars["wall_hits"],
+        cell_crossings=scalars["cell_crossings"],
+        stale=scalars["stale"],
+        predictions=scalars["predictions"],
+        virial=scalars["virial"],
+        max_overlap=scalars["max_overlap"],
+        max_queue=scalars["max_queue"],
+        last_time=0.0 if last is None else last[0],
+        last_kind=-1 if last is None else last[1],
+        last_i=-1 if last is None else int(order[last[2]]),
+        last_j=-1 if last is None else int(ids([last[3]])[0]),
+        grid_nx=grid.nx,
+        grid_ny=grid.ny,
+        ref_positions=caller(np.column_stack([old["_rx"], old["_ry"]]).reshape(n, 2)),
+        velocities=caller(np.column_stack([old["_vx"], old["_vy"]]).reshape(n, 2)),
+        ref_times=caller(old["_tr"]),
+        images=np.zeros((n, 2), dtype=np.int64),  # not recorded then: unwrapped positions start from here
+        collision_counts=caller(np.asarray(old["_count"], dtype=np.int64)),
+        cell=caller(np.asarray(old["_cell"], dtype=np.int64)),
+        cell_members=ids(members),
+        cell_sizes=np.asarray(sizes, dtype=np.int64),
+        kept_time=caller(np.asarray(old["_kept_time"], dtype=np.float64)),
+        kept_partner=caller(ids(old["_kept_partner"])),
+        kept_stamp=caller(np.asarray(old["_kept_stamp"], dtype=np.int64)),
+        order=order,
+        queue_owner=ids(old["queue_owner"]),
+        queue_time=np.asarray(old["queue_time"], dtype=np.float64),
+        queue_kind=kinds,
+        queue_other=np.where(kinds == 0, ids(payload[:, 1]), payload[:, 1]),
+        queue_stamp=payload[:, 2],
+    )
+    scene = {"segments": settings.get("segments", []), "pass_through": settings.get("pass_through", [])}
+    new_settings = {"record": settings["record"], "queue": settings["queue"], "cell_size": cell_size}
+    return scene, new_settings, state, old["events"]
+
+
+def resume(path, *, progress: bool = False, record_to=None):
     """Continue the run that wrote checkpoint ``path`` to the end it was given.
 
     Loads the checkpoint and calls ``run`` with the same ``until`` and the
-    remaining ``events``, the same ``checkpoint_every`` (writing to ``path``
+    remaining units of work, the same ``checkpoint_every`` (writing to ``path``
     again) and the same streamed log, cut back to what the checkpoint saw.
     The final state equals that of the run had it never stopped, bit for bit.
     A checkpoint of a finished run is loaded and returned as it is.
@@ -156,12 +323,12 @@ def resume(path, *, progress: bool = False, record_to=None) -> EventDriven:
     sim = load(path)
     if run["finished"]:
         return sim
-    events = None if run["events"] is None else run["events"] - sim._physical()
+    remaining = None if run["events"] is None else run["events"] - sim._units()
     if record_to is None:
         record_to = run["record_to"]
     sim.run(
         until=run["until"],
-        events=events,
+        events=remaining,
         progress=progress,
         record_to=None if record_to is None else Path(record_to),
         checkpoint=path,

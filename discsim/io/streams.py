@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
-from discsim.errors import CheckpointError, DiscsimError, TimeError
+from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_stream
 from discsim.model import Box, Discs
-from discsim.trajectory import reconstruct
+from discsim.trajectory import positions_from_log
 
 __all__ = ["STREAM_KIND", "StreamedEvents", "read_events", "stream_header", "trajectory_from_events"]
 
@@ -71,22 +71,24 @@ class StreamedEvents:
     end_time: float
     run_id: str
 
-    def trajectory(self, times) -> np.ndarray:
+    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``.
+
+        ``unwrapped=True`` follows each disc across the edges of a periodic box.
 
         Raises:
             TimeError: if a time is not finite or lies outside the logged span.
         """
-        times = np.atleast_1d(np.asarray(times, dtype=float))
-        if times.size and not np.isfinite(times).all():
-            msg = f"trajectory times must be finite, got {times[~np.isfinite(times)][0]!r}"
-            raise TimeError(msg)
-        tol = 1e-12 * max(1.0, abs(self.end_time))
-        if times.size and (times.min() < self.start_time - tol or times.max() > self.end_time + tol):
-            bad = times.min() if times.min() < self.start_time - tol else times.max()
-            msg = f"trajectory time {bad!r} is outside the logged span [{self.start_time!r}, {self.end_time!r}]"
-            raise TimeError(msg)
-        return reconstruct(self.events, self.discs.positions, self.discs.velocities, self.start_time, times, self.box)
+        return positions_from_log(
+            self.events,
+            self.discs,
+            self.box,
+            self.start_time,
+            self.end_time,
+            times,
+            span="logged span",
+            unwrapped=unwrapped,
+        )
 
 
 def read_events(path, *, partial: bool = False) -> StreamedEvents:

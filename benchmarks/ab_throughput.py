@@ -1,0 +1,293 @@
+"""A/B throughput of the event-driven engine: collisions/s of two source trees, side by side in one run.
+
+Shows whether a change keeps the engine's speed: the tree this script lives in
+("new") against another checkout of discsim ("base"), e.g. a ``git worktree`` of
+the commit before a refactor. Run::
+
+    python benchmarks/ab_throughput.py --base PATH_TO_OTHER_CHECKOUT
+    python benchmarks/ab_throughput.py --base PATH --sizes 1000 10000 --packings 0.3 --repeats 3 --collisions 200000
+    python benchmarks/ab_throughput.py --base PATH --quick --out DIR     # seconds: proves the script runs
+
+The defaults (N = 10^3, 10^4, 10^5; packing fractions 0.3 and 0.7; 5 repeats of
+300,000 collisions) take about a quarter of an hour.
+
+What one timed run is: a fresh Python process (:func:`measure`) with
+``PYTHONPATH`` set to the tree under test and a neutral empty working folder;
+it checks that ``discsim.__file__`` lies in that tree (an editable install of
+another tree must not win) and fails loudly otherwise. Through the public API
+alone, the same for both trees, it builds ``discsim.random_gas(N, phi, seed=s)``
+(a periodic box), runs ``EventDriven(discs, box, record=False)`` for
+``min(20,000, 2 N)`` collisions to warm up, then times ``sim.run(events=K)``
+with ``time.perf_counter``: collisions/s is the growth of
+``sim.counts["collisions"]`` over those seconds. Bytecode caches go to a
+temporary folder, so neither tree is written to.
+
+Order: repeat by repeat, point by point, base then new on even repeats and new
+then base on odd ones (ABBA), so that a slow spell of the machine hits both
+sides alike; the two runs of a pair use the same seed (the repeat's number), so
+they simulate the same gas.
+
+How to read the table (also ``ab_throughput.csv`` and ``ab_throughput.png`` in ``--out``):
+
+* ``base coll/s``, ``new coll/s``: median collisions per wall-clock second of each tree.
+* ``new/base``: median over the repeats of the per-pair ratio new/base; above 1
+  the new tree is faster. ``min`` and ``max`` are the extreme pair ratios: the
+  noise of this machine. A ratio is within the 3% target when it lies in
+  0.97-1.03 (the band of the plot); trust a verdict only when min-max is narrower
+  than the band, or repeat with more ``--repeats``.
+* ``base_label``, ``new_label`` (CSV): ``git rev-parse --short HEAD`` of each tree,
+  with ``+dirty`` when it has uncommitted changes (untracked files included).
+
+Figures only: nothing here asserts a speed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+from benchutils import DEFAULT_RESULTS, Column, announce, format_table, machine_summary, median, write_csv
+
+#: The tree this script belongs to: the "new" side.
+NEW_TREE = Path(__file__).resolve().parent.parent
+
+#: Sizes, packing fractions, repeats and timed collisions of the two modes.
+FULL = {"sizes": [1_000, 10_000, 100_000], "packings": [0.3, 0.7], "repeats": 5, "collisions": 300_000}
+QUICK = {"sizes": [500], "packings": [0.3], "repeats": 1, "collisions": 20_000}
+
+#: Warm-up before timing: ``WARMUP_PER_DISC`` collisions per disc, at most ``WARMUP_MAX``.
+WARMUP_PER_DISC = 2
+WARMUP_MAX = 20_000
+
+SIDES = ("base", "new")
+
+#: Run by :func:`measure` in a fresh interpreter; argv: tree, n, phi, seed, warm-up, timed collisions.
+#: Prints one JSON line. Public API only, so that it runs unchanged on both trees.
+_PROBE = """
+import gc, json, sys, time
+from pathlib import Path
+tree = Path(sys.argv[1]).resolve()
+n, phi, seed = int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+warmup, collisions = int(sys.argv[5]), int(sys.argv[6])
+import discsim
+where = Path(discsim.__file__).resolve()
+if not where.is_relative_to(tree):
+    sys.exit(f"discsim was imported from {where}, not from the tree under test {tree}")
+discs, box = discsim.random_gas(n, phi, seed=seed)
+sim = discsim.EventDriven(discs, box, record=False)
+sim.run(events=warmup)
+gc.collect()
+before = sim.counts["collisions"]
+start = time.perf_counter()
+sim.run(events=collisions)
+seconds = time.perf_counter() - start
+done = sim.counts["collisions"] - before
+print(json.dumps({"discsim_file": str(where), "collisions": done, "seconds": seconds,
+                  "collisions_per_s": done / seconds}))
+"""
+
+
+def warmup_collisions(n: int) -> int:
+    """Untimed collisions before the timed segment for ``n`` discs."""
+    return min(WARMUP_MAX, WARMUP_PER_DISC * n)
+
+
+def measure(tree: Path, n: int, packing: float, seed: int, collisions: int, scratch: Path) -> dict:
+    """One timed run of the tree ``tree`` in a fresh Python process.
+
+    Args:
+        tree: the source tree (the folder that holds the ``discsim`` package).
+        n: number of discs. packing: packing fraction of the periodic random gas.
+        seed: seed of :func:`discsim.random_gas`.
+        collisions: collisions in the timed segment.
+        scratch: a temporary folder; the run's working folder and bytecode cache go under it.
+
+    Returns:
+        The probe's dict: ``discsim_file``, ``collisions`` (timed), ``seconds``, ``collisions_per_s``.
+
+    Raises:
+        RuntimeError: if the run fails or imported discsim from elsewhere than ``tree``.
+    """
+    workdir = scratch / "cwd"
+    workdir.mkdir(exist_ok=True)
+    env = dict(os.environ, PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(scratch / "pycache"), PYTHONHASHSEED="0")
+    args = [str(tree), str(n), repr(packing), str(seed), str(warmup_collisions(n)), str(collisions)]
+    done = subprocess.run(
+        [sys.executable, "-c", _PROBE, *args], cwd=workdir, env=env, capture_output=True, text=True, check=False
+    )
+    if done.returncode:
+        msg = f"the timed run of {tree} at N={n} phi={packing} seed={seed} failed:\n{done.stderr}"
+        raise RuntimeError(msg)
+    result = json.loads(done.stdout.splitlines()[-1])
+    if not Path(result["discsim_file"]).resolve().is_relative_to(tree.resolve()):
+        msg = f"the timed run of {tree} imported discsim from {result['discsim_file']}"
+        raise RuntimeError(msg)
+    return result
+
+
+def tree_label(tree: Path) -> str:
+    """``git rev-parse --short HEAD`` of ``tree``, plus ``+dirty`` when it has uncommitted changes.
+
+    ``unknown`` when ``tree`` is not a git checkout (or git is missing).
+    """
+    try:
+        head = subprocess.run(
+            ["git", "-C", str(tree), "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False
+        )
+        status = subprocess.run(
+            ["git", "-C", str(tree), "status", "--porcelain"], capture_output=True, text=True, check=False
+        )
+    except OSError:
+        return "unknown"
+    if head.returncode or status.returncode:
+        return "unknown"
+    return head.stdout.strip() + ("+dirty" if status.stdout.strip() else "")
+
+
+def summarise(pairs: list[dict], n: int, packing: float) -> dict:
+    """One table row from the pairs of one point (each a dict with ``base`` and ``new`` collisions/s)."""
+    ratios = [p["new"] / p["base"] for p in pairs]
+    return {
+        "n": n,
+        "packing": packing,
+        "repeats": len(pairs),
+        "base_median": median([p["base"] for p in pairs]),
+        "new_median": median([p["new"] for p in pairs]),
+        "ratio_median": median(ratios),
+        "ratio_min": min(ratios),
+        "ratio_max": max(ratios),
+    }
+
+
+COLUMNS = [
+    Column("n", "N", ","),
+    Column("packing", "phi", ".2f"),
+    Column("repeats", "repeats"),
+    Column("base_median", "base coll/s", ",.0f"),
+    Column("new_median", "new coll/s", ",.0f"),
+    Column("ratio_median", "new/base", ".3f"),
+    Column("ratio_min", "min", ".3f"),
+    Column("ratio_max", "max", ".3f"),
+]
+CSV_KEYS = [c.key for c in COLUMNS] + ["base_label", "new_label"]
+
+
+def run_pairs(base: Path, options: dict, scratch: Path) -> list[dict]:
+    """Every timed run, interleaved ABBA over the repeats; one summary row per (N, phi)."""
+    trees = {"base": base, "new": NEW_TREE}
+    points = [(n, phi) for n in options["sizes"] for phi in options["packings"]]
+    pairs = {point: [] for point in points}
+    for repeat in range(options["repeats"]):
+        order = SIDES if repeat % 2 == 0 else SIDES[::-1]
+        for n, phi in points:
+            rates = {}
+            for side in order:
+                result = measure(trees[side], n, phi, repeat, options["collisions"], scratch)
+                rates[side] = result["collisions_per_s"]
+            ratio = rates["new"] / rates["base"]
+            announce(
+                f"  repeat {repeat + 1}/{options['repeats']} N={n:,} phi={phi:g} ({' then '.join(order)}): "
+                f"base {rates['base']:,.0f}, new {rates['new']:,.0f} coll/s, new/base {ratio:.3f}"
+            )
+            pairs[n, phi].append(rates)
+    return [summarise(pairs[point], *point) for point in points]
+
+
+def plot(rows: list[dict], path: Path, title: str) -> Path:
+    """The median ratio new/base against N, one series per packing fraction, min-max error bars, a 0.97-1.03 band."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4), constrained_layout=True)
+    ax.axhspan(0.97, 1.03, color="0.85", label="target: within 3%")
+    ax.axhline(1.0, color="0.5", linewidth=1)
+    fractions = sorted({r["packing"] for r in rows})
+    for k, phi in enumerate(fractions):
+        series = [r for r in rows if r["packing"] == phi]
+        shift = 1.06 ** (k - (len(fractions) - 1) / 2)  # side by side at each N, on the log axis
+        ratios = [r["ratio_median"] for r in series]
+        ax.errorbar(
+            [r["n"] * shift for r in series],
+            ratios,
+            yerr=[
+                [m - r["ratio_min"] for m, r in zip(ratios, series)],
+                [r["ratio_max"] - m for m, r in zip(ratios, series)],
+            ],
+            marker="o",
+            linestyle="none",
+            capsize=3,
+            label=f"phi={phi:g}",
+        )
+    low = min([0.95] + [r["ratio_min"] - 0.01 for r in rows])
+    high = max([1.05] + [r["ratio_max"] + 0.01 for r in rows])
+    ax.set(xscale="log", ylim=(low, high), xlabel="N discs", ylabel="collisions/s new / base (median, min-max)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The command line; options left out take the values of :data:`FULL`, or of :data:`QUICK` with ``--quick``."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--base", type=Path, required=True, help="the other checkout (the folder holding discsim/)")
+    parser.add_argument("--sizes", type=int, nargs="+", help=f"numbers of discs N (default {FULL['sizes']})")
+    parser.add_argument("--packings", type=float, nargs="+", help=f"packing fractions (default {FULL['packings']})")
+    parser.add_argument("--repeats", type=int, help=f"pairs of runs per point (default {FULL['repeats']})")
+    parser.add_argument("--collisions", type=int, help=f"timed collisions per run (default {FULL['collisions']:,})")
+    parser.add_argument("--quick", action="store_true", help=f"{QUICK}: proves the script runs")
+    parser.add_argument("--out", type=Path, default=DEFAULT_RESULTS, help="folder for the CSV and PNG")
+    args = parser.parse_args(argv)
+    defaults = QUICK if args.quick else FULL
+    for key, value in defaults.items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
+    if not (args.base / "discsim" / "__init__.py").is_file():
+        parser.error(f"--base {args.base} holds no discsim/__init__.py")
+    args.base = args.base.resolve()
+    for key in ("repeats", "collisions"):
+        if getattr(args, key) < 1:
+            parser.error(f"--{key} must be at least 1, got {getattr(args, key)}")
+    if min(args.sizes) < 1:
+        parser.error(f"--sizes must be at least 1, got {min(args.sizes)}")
+    args.out.mkdir(parents=True, exist_ok=True)
+    return args
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run every pair, print the table, write ``ab_throughput.csv`` and ``ab_throughput.png``; return the exit code."""
+    args = parse_args(argv)
+    options = {key: getattr(args, key) for key in FULL}
+    labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE)}
+    print(f"discsim A/B throughput; {machine_summary()}")
+    print(f"base: {args.base} ({labels['base_label']}); new: {NEW_TREE} ({labels['new_label']})")
+    if args.base == NEW_TREE:
+        print("base and new are the same tree: the ratios show the noise alone")
+    print(
+        f"{options['collisions']:,} timed collisions per run, after min({WARMUP_MAX:,}, {WARMUP_PER_DISC} N) "
+        f"to warm up; {options['repeats']} pair(s) per point, ABBA order, each run in a fresh process"
+    )
+    with tempfile.TemporaryDirectory(prefix="ab_throughput_") as scratch:
+        rows = run_pairs(args.base, options, Path(scratch))
+    for row in rows:
+        row.update(labels)
+    print(format_table(rows, COLUMNS))
+    csv_path = write_csv(args.out / "ab_throughput.csv", rows, CSV_KEYS)
+    title = f"discsim EventDriven: {labels['new_label']} / {labels['base_label']}"
+    png = plot(rows, args.out / "ab_throughput.png", title)
+    print(f"wrote {csv_path}, {png}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,65 @@
+"""The event-driven engine's invariants, checked over its public run state (any backend).
+
+:func:`check` asserts, in O(N), everything a consistent run must satisfy; the stress tests call it after each
+step (as sortedcontainers' ``_check``). A backend adds its own internal checks (``backend._check()``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from discsim.events import EventKind
+from discsim.model import Discs
+from discsim.scene import check_fits
+
+__all__ = ["check"]
+
+
+def check(sim) -> None:
+    """Assert every invariant of the event-driven engine ``sim`` and of its backend.
+
+    - every disc is in exactly one cell, the cell it lies in (or on its boundary, within roundoff);
+    - each disc has at most one pending event, none in the past, and a moving disc has one; the queue
+      holds at most N events;
+    - collision events name a partner, kept collisions a valid partner;
+    - the discs fit in the box without overlap (as the constructor checks).
+    """
+    sim._backend._check()
+    state = sim.state()
+    n = len(sim.discs)
+    grid, box = sim.grid, sim.box
+    assert (state.grid_nx, state.grid_ny) == (grid.nx, grid.ny)
+    assert len(state.cell_sizes) == len(grid)
+    assert int(state.cell_sizes.sum()) == n
+    assert sorted(state.cell_members.tolist()) == list(range(n)), "every disc is in exactly one cell"
+    owner_cell = np.repeat(np.arange(len(grid)), state.cell_sizes)
+    listed = np.empty(n, dtype=np.int64)
+    listed[state.cell_members] = owner_cell
+    assert np.array_equal(listed, state.cell), "a disc's cell and the cell's members disagree"
+    pos = box.wrap(state.positions_at(state.time))
+    expected = grid.cells_of(pos)
+    tol = 1e-9 * max(grid.lx, grid.ly)
+    for i in np.flatnonzero(expected != state.cell).tolist():  # only allowed on a cell boundary, within roundoff
+        cx, cy = divmod(int(state.cell[i]), grid.ny)
+        x, y = pos[i]
+        inside_x = cx * grid.lx - tol <= x <= (cx + 1) * grid.lx + tol or (
+            box.periodic and (x < tol or x > box.width - tol)
+        )
+        inside_y = cy * grid.ly - tol <= y <= (cy + 1) * grid.ly + tol or (
+            box.periodic and (y < tol or y > box.height - tol)
+        )
+        assert inside_x and inside_y, f"disc {i} at {pos[i]} is not in its cell {int(state.cell[i])}"
+    assert len(state.queue_owner) <= n
+    assert len(set(state.queue_owner.tolist())) == len(state.queue_owner), "one pending event per disc"
+    now = state.time - state.epoch
+    assert (state.queue_time >= now - 1e-12 * max(1.0, state.time)).all(), "an event lies in the past"
+    collisions = state.queue_kind == int(EventKind.COLLISION)
+    assert ((state.queue_other[collisions] >= 0) & (state.queue_other[collisions] < n)).all()
+    assert ((state.kept_partner >= -1) & (state.kept_partner < n)).all()
+    moving = np.isfinite(sim.discs.masses) & (state.velocities != 0).any(axis=1)
+    pending = np.zeros(n, dtype=bool)
+    pending[state.queue_owner] = True
+    idle = moving & ~pending  # a moving disc always has a wall, a crossing or a collision ahead
+    assert not idle.any(), f"moving disc {np.flatnonzero(idle)[0]} has no pending event"
+    d = sim.discs
+    check_fits(Discs(sim.positions, sim.velocities, d.radii, d.masses, d.groups), box, pass_through=sim.pass_through)

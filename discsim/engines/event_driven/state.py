@@ -1,0 +1,107 @@
+"""The event-driven engine's public run state: plain numpy arrays and scalars, in the caller's numbering.
+
+Every backend loads it and exports it (:class:`EventDrivenState`); a checkpoint stores it; an observer or an
+analysis may read it. Nothing in it is Python-specific.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from discsim.engines.base import EngineState
+
+__all__ = ["EventDrivenState"]
+
+
+@dataclass(eq=False)
+class EventDrivenState(EngineState):
+    """Everything an event-driven run needs to continue bit for bit (version 1).
+
+    Per-disc arrays are indexed in the caller's numbering (as ``discs``); disc
+    indices inside arrays (partners, cell members, queue owners) too. Times in
+    ``ref_times``, ``kept_time`` and ``queue_time`` count from ``epoch`` (the
+    internal clock's origin moves forward during long runs, so that these
+    times keep their resolution).
+
+    Scalars:
+        time: the current simulated time. epoch: origin of the internal times.
+        since_rebase: physical events since the epoch last moved.
+        collisions, wall_hits, cell_crossings, stale, predictions: the counters.
+        virial: sum over collisions of ``dp_i . (r_i - r_j)`` (pressure).
+        max_overlap: deepest overlap at a contact, as a fraction of the contact distance.
+        max_queue: most events pending at once.
+        last_time, last_kind, last_i, last_j: the last physical event (``last_kind`` -1 if none).
+        grid_nx, grid_ny: the cell grid the cell indices refer to.
+
+    Arrays:
+        ref_positions ``(N, 2)``, velocities ``(N, 2)``, ref_times ``(N,)``:
+            disc ``i`` is at ``ref_positions[i] + velocities[i] (t - ref_times[i])``
+            (not wrapped: may lie up to a cell outside a periodic box).
+        images ``(N, 2)`` int64: box lengths to add to that position to unwrap it.
+        collision_counts ``(N,)`` int64: per-disc counters that invalidate stale predictions.
+        cell ``(N,)`` int64: each disc's cell; cell_members ``(N,)`` and
+            cell_sizes ``(C,)``: the discs of each cell in order (order decides ties).
+        kept_time, kept_partner, kept_stamp ``(N,)``: each disc's earliest predicted
+            collision from its last full scan (partner -1 if none) and the partner's counter then.
+        order ``(N,)`` int64: the backend's internal numbering (internal disc ``k``
+            is disc ``order[k]``); it decides the order of simultaneous events.
+        queue_owner, queue_time, queue_kind, queue_other, queue_stamp ``(Q,)``:
+            the pending events, one per owner: kind (:class:`~discsim.events.EventKind`),
+            the partner (collision), wall axis, crossing direction or segment, and
+            the partner's counter (collisions only).
+    """
+
+    VERSION = 1
+
+    time: float
+    epoch: float
+    since_rebase: int
+    collisions: int
+    wall_hits: int
+    cell_crossings: int
+    stale: int
+    predictions: int
+    virial: float
+    max_overlap: float
+    max_queue: int
+    last_time: float
+    last_kind: int
+    last_i: int
+    last_j: int
+    grid_nx: int
+    grid_ny: int
+    ref_positions: np.ndarray
+    velocities: np.ndarray
+    ref_times: np.ndarray
+    images: np.ndarray
+    collision_counts: np.ndarray
+    cell: np.ndarray
+    cell_members: np.ndarray
+    cell_sizes: np.ndarray
+    kept_time: np.ndarray
+    kept_partner: np.ndarray
+    kept_stamp: np.ndarray
+    order: np.ndarray
+    queue_owner: np.ndarray
+    queue_time: np.ndarray
+    queue_kind: np.ndarray
+    queue_other: np.ndarray
+    queue_stamp: np.ndarray
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """The counters as ``EventDriven.counts`` gives them."""
+        return {
+            "collisions": self.collisions,
+            "wall_hits": self.wall_hits,
+            "cell_crossings": self.cell_crossings,
+            "stale": self.stale,
+            "predictions": self.predictions,
+        }
+
+    def positions_at(self, time: float) -> np.ndarray:
+        """``(N, 2)`` centres at ``time`` (absolute), not wrapped."""
+        t = time - self.epoch
+        return self.ref_positions + self.velocities * (t - self.ref_times)[:, None]

@@ -1,0 +1,130 @@
+"""What a frame works on: the scene as arrays (:class:`Shapes`), the discs' paths (:class:`Paths`) and the tally.
+
+The policies (:mod:`~discsim.engines.fixed_step.frame`, :mod:`~discsim.engines.fixed_step.sub_frame`) read
+and change these objects only; the engine owns them, exports them as a
+:class:`~discsim.engines.fixed_step.state.FixedStepState` and loads them back.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from discsim.events import EventLog
+from discsim.scene import Scene
+
+__all__ = ["Paths", "Shapes", "Tally"]
+
+
+class Shapes:
+    """The scene as the frame code reads it: fixed for the whole run.
+
+    Attributes:
+        box: the :class:`~discsim.model.Box`. scene: the :class:`~discsim.scene.Scene`.
+        radii ``(N,)`` float array and radius (list of N floats): the radii (length).
+        masses (list of N floats, inf for an obstacle). moving (list of N bools): finite mass.
+        diameter: the largest diameter (1 with no discs): the broad phase's cell side.
+        max_radius: half of ``diameter``.
+        seg_a, seg_b ``(S, 2)``: the segments' end points; seg_ends (list of S tuples
+            ``(x0, y0, x1, y1)``): the same as floats.
+        group (list of N ints) and blocked (G lists of G bools): the collision filter
+            (:meth:`~discsim.scene.Scene.passes`) as lists, or None when no groups pass through each other.
+    """
+
+    def __init__(self, scene: Scene):
+        discs, box = scene.discs, scene.box
+        self.scene = scene
+        self.box = box
+        self.diameter = 2.0 * float(discs.radii.max()) if len(discs) else 1.0
+        self.max_radius = 0.5 * self.diameter
+        self.radii = np.array(discs.radii)
+        self.radius = discs.radii.tolist()
+        self.masses = discs.masses.tolist()
+        self.moving = np.isfinite(discs.masses).tolist()
+        self.seg_a = np.array([segment.p0 for segment in scene.segments]).reshape(-1, 2)
+        self.seg_b = np.array([segment.p1 for segment in scene.segments]).reshape(-1, 2)
+        self.seg_ends = [(*segment.p0.tolist(), *segment.p1.tolist()) for segment in scene.segments]
+        self.group = scene.group.tolist() if scene.filtering else None
+        self.blocked = scene.blocked.tolist() if scene.filtering else None
+
+
+class Paths:
+    """Each disc's straight path since it last changed course, and where the discs were at the last frame.
+
+    Disc ``i`` is at ``ref_positions[i] + velocities[i] * (t - ref_times[i])`` (lazy clocks, as in the
+    event log, so frame positions and ``trajectory()`` agree to the last bit); that point is not wrapped,
+    and adding ``images[i] * box.size`` to it unwraps it.
+
+    Attributes:
+        box: the :class:`~discsim.model.Box`.
+        ref_positions ``(N, 2)``: each disc's position at its reference time (length).
+        ref_times ``(N,)``: when each disc last changed course (time).
+        velocities ``(N, 2)``: the velocities (length per time).
+        images ``(N, 2)`` int64: box lengths to add to ``ref_positions`` to unwrap them.
+        frame_positions ``(N, 2)``: the positions at the last frame, wrapped into a periodic box.
+    """
+
+    def __init__(self, box, ref_positions, ref_times, velocities, images, frame_positions):
+        self.box = box
+        self.ref_positions = ref_positions
+        self.ref_times = ref_times
+        self.velocities = velocities
+        self.images = images
+        self.frame_positions = frame_positions
+
+    def flown(self, t: float) -> np.ndarray:
+        """``(N, 2)`` positions at time ``t`` on the current paths, not wrapped."""
+        return self.ref_positions + self.velocities * (t - self.ref_times)[:, None]
+
+    def restart(self, rows, positions, t: float, flown=None) -> None:
+        """Discs ``rows`` start new paths at time ``t`` from ``positions`` (their velocities set apart).
+
+        Args:
+            rows: disc indices (an int, a list or an int array).
+            positions: their new reference positions (``(2,)`` or ``(len(rows), 2)``).
+            t: the new reference time.
+            flown: in a periodic box, where the old paths put the discs at ``t`` (:meth:`flown`, not
+                wrapped); the whole box lengths between it and ``positions`` go to ``images``.
+        """
+        if flown is not None and self.box.periodic:
+            size = self.box.size
+            self.images[rows] += np.round((flown - positions) / size).astype(np.int64)
+        self.ref_positions[rows] = positions
+        self.ref_times[rows] = t
+
+    def turn(self, disc: int, t: float, x: float, y: float, vx: float, vy: float) -> tuple[float, float]:
+        """Disc ``disc`` changes course at time ``t`` at ``(x, y)`` (on its path, not wrapped) to ``(vx, vy)``.
+
+        Returns the new reference position, wrapped into a periodic box.
+        """
+        if self.box.periodic:
+            flown = np.array([x, y])
+            here = self.box.wrap(flown)
+            wx, wy = here.tolist()
+            if wx != x or wy != y:  # it left the box since its last change of course
+                self.images[disc] += np.round((flown - here) / self.box.size).astype(np.int64)
+            x, y = wx, wy
+        self.ref_positions[disc] = (x, y)
+        self.ref_times[disc] = t
+        self.velocities[disc] = (vx, vy)
+        return x, y
+
+    def unwrapped(self, t: float) -> np.ndarray:
+        """``(N, 2)`` positions at time ``t``, each disc followed across the edges of a periodic box."""
+        return self.ref_positions + self.images * self.box.size + self.velocities * (t - self.ref_times)[:, None]
+
+
+class Tally:
+    """The run's counters, the deepest overlap seen, and the log the current frame writes to.
+
+    Attributes:
+        counts (dict[str, int]): see :attr:`FixedStep.counts <discsim.engines.fixed_step.FixedStep>`.
+        max_overlap (float): the deepest disc-disc overlap seen, as a fraction of the contact distance.
+        log (EventLog or None): where responses are logged (None: not recorded).
+    """
+
+    NAMES = ("frames", "pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits", "list_builds")
+
+    def __init__(self, counts: dict[str, int] | None = None, max_overlap: float = 0.0):
+        self.counts = {name: 0 for name in self.NAMES} if counts is None else {n: int(counts[n]) for n in self.NAMES}
+        self.max_overlap = float(max_overlap)
+        self.log: EventLog | None = None

@@ -1,0 +1,77 @@
+"""The fixed-step engine's public run state: plain numpy arrays and scalars.
+
+A checkpoint stores it (:mod:`discsim.io.checkpoints`); an observer or an analysis may read it. Nothing
+in it is Python-specific.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from discsim.engines.base import EngineState
+
+__all__ = ["FixedStepState"]
+
+
+@dataclass(eq=False)
+class FixedStepState(EngineState):
+    """Everything a fixed-step run needs to continue bit for bit (version 1).
+
+    Per-disc arrays are indexed as ``discs``. Frame ``k`` falls at ``start_time + k / frame_rate`` (or
+    ``start_time + k * dt``, as the engine was built), so the frame count fixes the frame times.
+
+    Scalars:
+        time: the current simulated time (at or after the last frame).
+        frame_time: the time of the last frame done (the start time before the first).
+        frames: frames done since the start.
+        pair_tests, segment_tests, bisection_tests, detections, wall_hits, list_builds:
+            the counters (see ``FixedStep.counts``).
+        max_overlap: the deepest disc-disc overlap seen, as a fraction of the contact distance.
+
+    Arrays:
+        ref_positions ``(N, 2)``, velocities ``(N, 2)``, ref_times ``(N,)``:
+            disc ``i`` is at ``ref_positions[i] + velocities[i] (t - ref_times[i])``
+            (lengths, length per time, times; not wrapped).
+        images ``(N, 2)`` int64: box lengths to add to ``ref_positions`` to unwrap them
+            (zero in a walled box).
+        frame_positions ``(N, 2)``: the positions at ``frame_time``, wrapped into a periodic box.
+        list_positions ``(N, 2)``: where the discs were when the Verlet list of the ``"grid"``
+            broad phase was last built, or ``(0, 2)`` if it never was (``list_builds == 0``).
+        list_i, list_j ``(P,)`` int64: the pairs of discs in that list.
+    """
+
+    VERSION = 1
+
+    time: float
+    frame_time: float
+    frames: int
+    pair_tests: int
+    segment_tests: int
+    bisection_tests: int
+    detections: int
+    wall_hits: int
+    list_builds: int
+    max_overlap: float
+    ref_positions: np.ndarray
+    velocities: np.ndarray
+    ref_times: np.ndarray
+    images: np.ndarray
+    frame_positions: np.ndarray
+    list_positions: np.ndarray
+    list_i: np.ndarray
+    list_j: np.ndarray
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """The counters as ``FixedStep.counts`` gives them."""
+        return {
+            "frames": self.frames,
+            "pair_tests": self.pair_tests,
+            "segment_tests": self.segment_tests,
+            "bisection_tests": self.bisection_tests,
+            "detections": self.detections,
+            "wall_hits": self.wall_hits,
+            "list_builds": self.list_builds,
+        }

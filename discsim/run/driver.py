@@ -1,0 +1,193 @@
+"""The one run driver: ``run(until=..., events=..., observers=[...])`` for every engine.
+
+The driver checks the limits once ("no limit" is ``None``), asks the engine for work in chunks
+(``engine._advance``), and between chunks serves the observers: the progress bar, the event stream, the
+checkpointer and any user callback (:mod:`discsim.run.observers`). With no observer, a run is one call of
+the engine's loop. Chunks change nothing in the dynamics: the engine resumes exactly where it stopped.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from discsim._validate import check_count, check_until
+from discsim.errors import InvalidArgumentError, TimeError
+from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
+
+__all__ = ["RunPlan", "drive"]
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What a run was asked to do, as observers see it.
+
+    Attributes:
+        until: stop time, or None. limit: units of work to do, or None.
+        unit: what a unit is ("events" or "frames").
+        start_time: the engine's time when the run started.
+        start_units: units of work done before the run (``engine._units()``).
+        record: the engine's own ``record`` setting (a run with observers may record meanwhile).
+        checkpoint_every: units between checkpoints, or None.
+        record_to: the streamed log's absolute path, or None.
+    """
+
+    until: float | None
+    limit: int | None
+    unit: str
+    start_time: float
+    start_units: int
+    record: bool
+    checkpoint_every: int | None = None
+    record_to: str | None = None
+
+    def target(self, finished: bool) -> dict:
+        """The run's goal as a checkpoint stores it: ``until``, total ``events``, ``finished``, ..."""
+        return {
+            "until": None if self.until in (None, math.inf) else self.until,
+            "events": None if self.limit is None else self.start_units + self.limit,
+            "checkpoint_every": self.checkpoint_every,
+            "record_to": self.record_to,
+            "finished": finished,
+        }
+
+
+def drive(
+    engine,
+    *,
+    until=None,
+    limit=None,
+    observers=(),
+    progress: bool = False,
+    record_to=None,
+    checkpoint=None,
+    checkpoint_every=None,
+) -> int:
+    """Run ``engine`` up to time ``until`` and/or for ``limit`` units of work; return the units done.
+
+    Args:
+        engine: any discsim engine (:class:`~discsim.engines.base.Engine`).
+        until: stop time; events (or frames) at exactly ``until`` are done, and
+            ``time`` is ``until`` at the end (unless ``limit`` stopped the run first).
+        limit: units of work (physical events for ``EventDriven``, frames for
+            ``FixedStep``); None for no limit.
+        observers: :class:`~discsim.run.observers.Observer` objects, or plain
+            callables ``fn(engine, events)`` called after each chunk with the
+            chunk's events (a structured array of :data:`~discsim.events.EVENT_DTYPE`).
+        progress: show a progress bar (tqdm when installed).
+        record_to: stream the event log to this file (see :class:`~discsim.run.observers.EventStream`).
+        checkpoint: write checkpoints to this file (see :class:`~discsim.run.observers.Checkpointer`).
+        checkpoint_every: units of work between checkpoints (needs ``checkpoint``).
+
+    Raises:
+        TimeError: if ``until`` is before ``time``, NaN, or infinite without ``limit``.
+        InvalidArgumentError: if neither limit is given, or a count is not a whole number.
+        CheckpointError: if ``record_to`` or ``checkpoint`` names a foreign or damaged file.
+            Nothing has been simulated then.
+    """
+    unit = engine.unit
+    until = check_until(until, engine.time)
+    limit = check_count(unit, limit)
+    if until is None and limit is None:
+        msg = f"run() needs until=... or {unit}=..."
+        raise InvalidArgumentError(msg)
+    if limit is None and until == math.inf:
+        msg = f"run(until=inf) never ends: give a finite until or {unit}=..."
+        raise TimeError(msg)
+    every = check_count("checkpoint_every", checkpoint_every)
+    if every is not None and checkpoint is None:
+        msg = "checkpoint_every needs checkpoint=path"
+        raise InvalidArgumentError(msg)
+    if every == 0:
+        msg = f"checkpoint_every must be a positive integer ({unit}), got {checkpoint_every!r}"
+        raise InvalidArgumentError(msg)
+    stop = math.inf if until is None else until
+    chain = _observers(engine, observers, progress, record_to, checkpoint, every)
+    if not chain:
+        done = engine._advance(stop, limit)
+        if until is not None and done != limit:  # stopped by the clock, not by the count
+            engine._settle(until)
+        return done
+    stream = next((o for o in chain if isinstance(o, EventStream)), None)
+    plan = RunPlan(
+        until,
+        limit,
+        unit,
+        engine.time,
+        engine._units(),
+        engine.record,
+        every,
+        None if stream is None else str(stream.path.absolute()),
+    )
+    return _drive_chunks(engine, plan, stop, chain, stream)
+
+
+def _observers(engine, observers, progress, record_to, checkpoint, every) -> list[Observer]:
+    """The run's observers in the order they are served: stream, checkpointer, progress bar, the user's."""
+    chain: list[Observer] = []
+    stream = None
+    if record_to is not None:
+        stream = EventStream(record_to)
+        chain.append(stream)
+    if checkpoint is not None:
+        chain.append(Checkpointer(checkpoint, every, stream))
+    if progress:
+        chain.append(ProgressBar())
+    for k, observer in enumerate(observers or ()):
+        if isinstance(observer, Observer):
+            chain.append(observer)
+        elif callable(observer):
+            chain.append(Callback(observer))
+        else:
+            msg = f"observers[{k}] must be a discsim Observer or a callable, got {type(observer).__name__}"
+            raise InvalidArgumentError(msg)
+    if stream is not None and checkpoint is not None and stream.path.absolute() == chain[1].path.absolute():
+        msg = f"record_to and checkpoint must be two different files, got {stream.path} twice"
+        raise InvalidArgumentError(msg)
+    return chain
+
+
+def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], stream) -> int:
+    """Run in chunks of the engine's loop, serving ``chain`` between them."""
+    for observer in chain:  # every check before anything changes
+        observer.check(engine, plan)
+    wants_events = any(observer.wants_events for observer in chain)
+    recording = engine.record
+    keep = recording and stream is None  # the log stays in memory (else the stream takes it)
+    log = engine._log
+    started: list[Observer] = []
+    done = 0
+    completed = False
+    try:
+        engine.record = recording or wants_events  # the loop logs only when record is on
+        for observer in chain:
+            observer.start(engine, plan)
+            started.append(observer)
+        if not keep:
+            log.clear()  # what the stream wanted of it, it has taken
+        mark = len(log)
+        while True:
+            chunk = plan.limit - done if plan.limit is not None else None
+            for observer in chain:
+                want = observer.next_stop(engine)
+                if want is not None:
+                    chunk = max(1, want) if chunk is None else min(chunk, max(1, want))
+            k = engine._advance(stop, chunk)
+            done += k
+            finishing = chunk is None or k < chunk or done == plan.limit  # None: the call did it all
+            if plan.until is not None and finishing and done != plan.limit:
+                engine._settle(plan.until)
+            events = log.since(mark) if wants_events else None
+            if not keep:
+                log.clear()
+            mark = len(log)
+            for observer in chain:
+                observer.update(engine, events, k, finishing)
+            if finishing:
+                break
+        completed = True
+    finally:
+        engine.record = recording
+        for observer in reversed(started):
+            observer.finish(engine, completed)
+    return done

@@ -1,0 +1,44 @@
+"""benchmarks/ab_throughput.py runs in its quick mode and times the tree it is told to.
+
+No test here asserts a speed: timings belong to the script's output, not to pass/fail.
+"""
+
+import csv
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+BENCHMARKS = REPO / "benchmarks"
+
+
+@pytest.fixture(scope="module")
+def ab_throughput():
+    """benchmarks/ab_throughput.py as a module (it imports ``benchutils`` from its own folder)."""
+    spec = importlib.util.spec_from_file_location("ab_throughput", BENCHMARKS / "ab_throughput.py")
+    module = importlib.util.module_from_spec(spec)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(BENCHMARKS))
+        patch.setitem(sys.modules, "ab_throughput", module)
+        spec.loader.exec_module(module)
+        yield module
+
+
+def test_quick_run_against_itself_writes_one_row(ab_throughput, tmp_path):
+    assert ab_throughput.main(["--quick", "--base", str(REPO), "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "ab_throughput.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 1  # N = 500, phi = 0.3
+    row = rows[0]
+    assert (int(row["n"]), float(row["packing"]), int(row["repeats"])) == (500, 0.3, 1)
+    assert float(row["ratio_median"]) > 0
+    assert row["base_label"] == row["new_label"]  # one tree on both sides
+    assert (tmp_path / "ab_throughput.png").stat().st_size > 0
+
+
+def test_a_tree_without_discsim_fails_loudly(ab_throughput, tmp_path):
+    # PYTHONPATH points at an empty folder: the probe must not time an installed discsim instead.
+    with pytest.raises(RuntimeError, match="failed"):
+        ab_throughput.measure(tmp_path, 10, 0.3, 0, 10, tmp_path)

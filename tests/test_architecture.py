@@ -6,8 +6,7 @@ import ast
 from pathlib import Path
 
 import pytest
-
-PACKAGE = Path(__file__).resolve().parent.parent / "discsim"
+from paths import PACKAGE
 
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {

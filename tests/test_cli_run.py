@@ -13,11 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import ROOT
 
 import discsim as ds
 from discsim.cli import RUN_FILES, main
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def _args(out, until=10.0, packing=0.4, n=150, *extra) -> list[str]:

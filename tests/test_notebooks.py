@@ -20,10 +20,11 @@ import time
 from pathlib import Path
 
 import pytest
+from paths import NOTEBOOKS
 
 import discsim
 
-NOTEBOOKS_DIR = Path(__file__).resolve().parent.parent / "notebooks"
+NOTEBOOKS_DIR = NOTEBOOKS
 NOTEBOOKS = sorted(NOTEBOOKS_DIR.glob("*.ipynb"))
 #: Seconds any one cell may take before the run fails (whole notebooks take 1-2 minutes).
 CELL_TIMEOUT = 600

@@ -6,7 +6,7 @@ Run from the repository root, on the engine whose behaviour is the reference::
 
 The scenes cover walled and periodic boxes, mixtures of radii and masses, obstacles, segment walls,
 pass-through groups, N from 2 to 5,000 (internal renumbering from N = 4096 on), a run long enough to move the
-internal clock's epoch, both engines and all five PIT policies. ``tests/test_golden.py`` replays every scene
+internal clock's epoch, both engines and all five PIT policies. ``tests/engines/test_golden.py`` replays every scene
 and compares every field of the log, the final state and the counters exactly. The logs were first recorded
 on commit d8e6d8f, before the redesign of issue 14; the files must never be re-recorded to make a test pass.
 

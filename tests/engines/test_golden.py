@@ -16,11 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import FIXTURES, GOLDEN
 
 import discsim as ds
-
-GOLDEN = Path(__file__).resolve().parent / "golden"
-FIXTURES = Path(__file__).resolve().parent / "fixtures"
 
 _spec = importlib.util.spec_from_file_location("make_golden", GOLDEN / "make_golden.py")
 make_golden = importlib.util.module_from_spec(_spec)

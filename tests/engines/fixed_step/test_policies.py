@@ -12,12 +12,12 @@ import math
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from paths import BENCHMARKS
 
 import discsim as ds
 from discsim.engines.fixed_step import POLICIES
@@ -25,7 +25,6 @@ from discsim.errors import InvalidDiscsError, OutsideBoxError
 from discsim.events import Event
 from discsim.kernels import time_of_impact, time_of_impact_bisect
 
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
 FRAME_POLICIES = ["resolve", "revert", "separate"]
 
 coord = st.floats(-50, 50, allow_nan=False)

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import csv
 import importlib.util
-from pathlib import Path
 
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+from paths import BENCHMARKS
+
 RESULTS = BENCHMARKS / "results"
 
 _spec = importlib.util.spec_from_file_location("performance_doc", BENCHMARKS / "performance_doc.py")

@@ -12,8 +12,7 @@ import sys
 from pathlib import Path
 
 import pytest
-
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+from paths import BENCHMARKS
 
 
 def _run_quick(script: str, results: Path) -> subprocess.CompletedProcess:

@@ -16,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import BENCHMARKS
 
 import discsim as ds
-
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
 
 
 def _load(name: str, path: Path):

@@ -5,12 +5,13 @@ No test here asserts a speed: timings belong to the script's output, not to pass
 
 import csv
 import importlib.util
+import shutil
 import sys
-from pathlib import Path
 
 import pytest
+from paths import ROOT
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = ROOT
 BENCHMARKS = REPO / "benchmarks"
 
 
@@ -42,3 +43,18 @@ def test_a_tree_without_discsim_fails_loudly(ab_throughput, tmp_path):
     # PYTHONPATH points at an empty folder: the probe must not time an installed discsim instead.
     with pytest.raises(RuntimeError, match="failed"):
         ab_throughput.measure(tmp_path, 10, 0.3, 0, 10, tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="counting instructions needs valgrind")
+def test_instruction_counts_of_a_tree_against_itself_agree_exactly(tmp_path):
+    spec = importlib.util.spec_from_file_location("ab_instructions", BENCHMARKS / "ab_instructions.py")
+    module = importlib.util.module_from_spec(spec)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(BENCHMARKS))
+        spec.loader.exec_module(module)
+        assert module.main(["--quick", "--base", str(REPO), "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "ab_instructions.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 1 and float(rows[0]["base_per_collision"]) > 0
+    assert float(rows[0]["ratio"]) == pytest.approx(1.0, abs=2e-3)  # the same tree, binary and hash seed

@@ -18,7 +18,7 @@ from discsim.analysis.compare import Comparison, compare
 from discsim.analysis.theory import enskog_collision_rate, henderson_z, speed_cdf, speed_pdf
 from discsim.analysis.thermo import compressibility_factor
 from discsim.engines.event_driven import EventDriven, EventDrivenState
-from discsim.engines.fixed_step import POLICIES, FixedStep
+from discsim.engines.fixed_step import POLICIES, FixedStep, FixedStepState
 from discsim.errors import (
     BoxTooSmallError,
     CheckpointError,
@@ -67,6 +67,7 @@ __all__ = [
     "EventKind",
     "EventStream",
     "FixedStep",
+    "FixedStepState",
     "InvalidArgumentError",
     "InvalidDiscsError",
     "Observer",

@@ -67,6 +67,9 @@ def check_until(until, now: float) -> float | None:
     """
     if until is None:
         return None
+    if isinstance(until, (bool, str, bytes)):
+        msg = f"until must be a number, got {until!r}"
+        raise TimeError(msg)
     try:
         value = float(until)
     except (TypeError, ValueError) as exc:

@@ -2,7 +2,7 @@
 
 Each record holds the time, the kind (disc-disc collision or wall hit), the
 discs involved, and their positions and velocities just after the event.
-Between events discs fly in straight lines, so :func:`reconstruct` gives the
+Between events discs fly in straight lines, so :func:`discsim.trajectory.reconstruct` gives the
 exact position of every disc at any time covered by the log, with no
 re-simulation. Both engines write the same records.
 """

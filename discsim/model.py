@@ -194,6 +194,15 @@ class Box:
             raise InvalidDiscsError(msg)
         object.__setattr__(self, "periodic", bool(self.periodic))
 
+    def as_dict(self) -> dict:
+        """``{"width", "height", "periodic"}``, as files store a box; ``Box(**d)`` reads it back.
+
+        Example:
+            >>> Box(**Box(3.0, 2.0, periodic=True).as_dict()) == Box(3.0, 2.0, periodic=True)
+            True
+        """
+        return {"width": self.width, "height": self.height, "periodic": self.periodic}
+
     @property
     def area(self) -> float:
         """Area ``width * height``."""

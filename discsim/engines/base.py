@@ -5,12 +5,14 @@ An engine holds a validated :class:`~discsim.scene.Scene` (``discs`` at the star
 implements three small protocols, all here as abstract methods:
 
 - the **driver's** (:mod:`discsim.run.driver`): ``_advance(until, limit)`` does up to ``limit`` units of
-  work (physical events, or frames) up to time ``until``; ``_units()`` counts them; ``_settle(until)``
-  moves the clock to ``until`` when the run stopped on time;
+  work (physical events, or frames) up to time ``until``, logging each event in ``_log`` when ``record``
+  or ``_recording`` (set by the driver while an observer wants events) is on; ``_units()`` counts the
+  units, ``_event_count()`` the events the log would hold; ``_settle(until)`` moves the clock to ``until``
+  when the run stopped on time;
 - the **checkpoint's** (:mod:`discsim.io.checkpoints`): ``state()`` exports the public run state (an
   :class:`EngineState`: numpy arrays and scalars, versioned), ``_settings()`` the constructor's options as
   JSON, and ``_restore(scene, settings, state, events, start_time)`` rebuilds the engine;
-- the **user's**: ``step()``, ``positions``, ``velocities``, ``unwrapped_positions``, ``counts``, ``pressure()``.
+- the **user's**: ``step()``, ``positions``, ``velocities``, ``unwrapped_positions``, ``counts``.
 
 Everything else (``run``, ``save``, ``events``, exact ``trajectory``, energies, momentum, ``snapshot``) is
 written here once, so ``compare``, ``plot``, notebooks and benchmarks work with any engine and backend.
@@ -26,7 +28,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from discsim.errors import CheckpointError, InvalidArgumentError
+from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
 from discsim.events import EVENT_DTYPE, EventLog
 from discsim.model import Box, Discs, kinetic_energy, momentum
 from discsim.scene import Scene
@@ -96,6 +98,8 @@ class Engine(ABC):
         self.record = bool(record)
         self.start_time = 0.0
         self._log = EventLog()
+        self._recording = False  # the driver records for its observers meanwhile, whatever ``record`` says
+        self._broken: str | None = None  # why the engine cannot go on (an exception inside its loop)
         self._run_id: str | None = None  # identifies this run in its checkpoints and streamed log
         self._stream: dict | None = None  # this run's log on disk: path, run_id, base, records, end
 
@@ -111,6 +115,28 @@ class Engine(ABC):
     @abstractmethod
     def _units(self) -> int:
         """Units of work done since the start (physical events, or frames)."""
+
+    @abstractmethod
+    def _event_count(self) -> int:
+        """Events the log holds (or would hold if recorded from the start) since the start."""
+
+    @property
+    def _logging(self) -> bool:
+        """Whether the loop logs events now: ``record``, or an observer of the current run wants them."""
+        return self.record or self._recording
+
+    def _check_usable(self) -> None:
+        """Refuse to go on after an exception inside the engine's own loop left it half-way through an event.
+
+        Raises:
+            DiscsimError: naming what happened and how to go on (a checkpoint and :func:`discsim.resume`).
+        """
+        if self._broken is not None:
+            msg = (
+                f"this {type(self).__name__} was interrupted inside its event loop ({self._broken}) and its state "
+                "may be half-way through an event; continue from a checkpoint (ds.resume or ds.load) instead"
+            )
+            raise DiscsimError(msg)
 
     def _settle(self, until: float) -> None:
         """Move the clock to ``until`` after a run that stopped on time."""
@@ -200,6 +226,7 @@ class Engine(ABC):
         """
         from discsim.io.checkpoints import save
 
+        self._check_usable()
         return save(self, path)
 
     @property

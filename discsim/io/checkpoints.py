@@ -32,6 +32,7 @@ from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
 from discsim.model import Box, Discs, Segment
 from discsim.scene import Scene
+from discsim.trajectory import reconstruct
 
 __all__ = ["checkpoint_info", "load", "resume", "save", "write_checkpoint"]
 
@@ -66,7 +67,7 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         "start_time": engine.start_time,
         "time": engine.time,
         "counts": dict(engine.counts),
-        "box": {"width": box.width, "height": box.height, "periodic": box.periodic},
+        "box": box.as_dict(),
         "scene": {
             "segments": [[*s.p0.tolist(), *s.p1.tolist()] for s in scene.segments],
             "pass_through": sorted(scene.pass_through),
@@ -210,7 +211,8 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
 
     That layout stored the engine's private lists by attribute name, in its internal numbering (``order``;
     files older still used the caller's numbering throughout), and each queued event's payload as
-    ``(kind, other, stamp)``.
+    ``(kind, other, stamp)``. It kept no image counters: they are rebuilt from the log when it covers
+    the whole run, and start from zero otherwise (``unwrapped_positions`` then count from the load).
     """
     old = dict(meta["state"])
     old.update({k.removeprefix("state."): v for k, v in arrays.items() if k.startswith("state.")})
@@ -233,15 +235,8 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
     members, sizes = old["cell_members"], old["cell_sizes"]
     last = scalars["last"]
     box = Box(**meta["box"])
-    from discsim.cells import CellGrid
-
-    diameter = 2.0 * float(np.max(arrays["discs.radii"])) if n else 1.0
     cell_size = settings["cell_size"]
-    grid = (
-        CellGrid(box, diameter, max_cells=4 * n + 9)
-        if cell_size is None
-        else CellGrid(box, float(cell_size), what="the cell_size asked for")
-    )
+    grid = EventDriven.cell_grid(arrays["discs.radii"], box, cell_size)
     state = EventDrivenState(
         time=scalars["time"],
         epoch=scalars.get("epoch", 0.0),
@@ -263,7 +258,7 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
         ref_positions=caller(np.column_stack([old["_rx"], old["_ry"]]).reshape(n, 2)),
         velocities=caller(np.column_stack([old["_vx"], old["_vy"]]).reshape(n, 2)),
         ref_times=caller(old["_tr"]),
-        images=np.zeros((n, 2), dtype=np.int64),  # not recorded then: unwrapped positions start from here
+        images=np.zeros((n, 2), dtype=np.int64),  # not recorded then: from the log below, where there is one
         collision_counts=caller(np.asarray(old["_count"], dtype=np.int64)),
         cell=caller(np.asarray(old["_cell"], dtype=np.int64)),
         cell_members=ids(members),
@@ -278,9 +273,16 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
         queue_other=np.where(kinds == 0, ids(payload[:, 1]), payload[:, 1]),
         queue_stamp=payload[:, 2],
     )
+    events = old["events"]
+    if box.periodic and len(events) and meta["stream"] is None and meta["start_time"] == 0.0:
+        # The log covers the whole run: the whole box lengths each disc crossed are in it.
+        unwrapped = reconstruct(
+            events, arrays["discs.positions"], arrays["discs.velocities"], 0.0, [state.time], box, unwrapped=True
+        )[0]
+        state.images = np.round((unwrapped - state.positions_at(state.time)) / box.size).astype(np.int64)
     scene = {"segments": settings.get("segments", []), "pass_through": settings.get("pass_through", [])}
     new_settings = {"record": settings["record"], "queue": settings["queue"], "cell_size": cell_size}
-    return scene, new_settings, state, old["events"]
+    return scene, new_settings, state, events
 
 
 def resume(path, *, progress: bool = False, record_to=None):

@@ -38,7 +38,7 @@ def stream_header(discs: Discs, box: Box, start_time: float, run_id: str, base: 
         "start_time": float(start_time),
         "base": int(base),
         "n": len(discs),
-        "box": {"width": box.width, "height": box.height, "periodic": box.periodic},
+        "box": box.as_dict(),
     }
     arrays = {
         "positions": discs.positions,
@@ -92,7 +92,7 @@ class StreamedEvents:
 
 
 def read_events(path, *, partial: bool = False) -> StreamedEvents:
-    """Read an event log written by ``EventDriven.run(record_to=path)``.
+    """Read an event log written by ``run(record_to=path)`` (either engine).
 
     Every chunk's checksum is verified. The whole log is loaded into memory
     (89 bytes per event).
@@ -143,13 +143,14 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
     return StreamedEvents(stream.records, discs, box, start_time, end_time, run_id)
 
 
-def trajectory_from_events(source, times) -> np.ndarray:
+def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndarray:
     """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)`` from a streamed event log.
 
     Args:
         source: a path to a log written by ``run(record_to=...)``, or a
             :class:`StreamedEvents` already read by :func:`read_events`.
         times: times within the logged span ``[start_time, end_time]``.
+        unwrapped: follow each disc across the edges of a periodic box.
 
     Raises:
         CheckpointError: if the file is damaged (see :func:`read_events`).
@@ -165,4 +166,4 @@ def trajectory_from_events(source, times) -> np.ndarray:
         True
     """
     log = source if isinstance(source, StreamedEvents) else read_events(Path(source))
-    return log.trajectory(times)
+    return log.trajectory(times, unwrapped=unwrapped)

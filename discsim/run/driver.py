@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from discsim._validate import check_count, check_until
+from discsim._validate import check_count, check_until, is_count
 from discsim.errors import InvalidArgumentError, TimeError
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 
@@ -85,30 +85,34 @@ def drive(
         CheckpointError: if ``record_to`` or ``checkpoint`` names a foreign or damaged file.
             Nothing has been simulated then.
     """
+    engine._check_usable()
     unit = engine.unit
     until = check_until(until, engine.time)
+    if checkpoint_every is not None and (not is_count(checkpoint_every) or checkpoint_every == 0):
+        msg = f"checkpoint_every must be a positive integer ({unit}), got {checkpoint_every!r}"
+        raise InvalidArgumentError(msg)
     limit = check_count(unit, limit)
     if until is None and limit is None:
         msg = f"run() needs until=... or {unit}=..."
         raise InvalidArgumentError(msg)
-    if limit is None and until == math.inf:
-        msg = f"run(until=inf) never ends: give a finite until or {unit}=..."
-        raise TimeError(msg)
-    every = check_count("checkpoint_every", checkpoint_every)
+    if until == math.inf:
+        if limit is None:
+            msg = f"run(until=inf) never ends: give a finite until or {unit}=..."
+            raise TimeError(msg)
+        until = None  # a count alone bounds the run: None is the one spelling of no limit
+    every = None if checkpoint_every is None else int(checkpoint_every)
     if every is not None and checkpoint is None:
         msg = "checkpoint_every needs checkpoint=path"
         raise InvalidArgumentError(msg)
-    if every == 0:
-        msg = f"checkpoint_every must be a positive integer ({unit}), got {checkpoint_every!r}"
-        raise InvalidArgumentError(msg)
     stop = math.inf if until is None else until
-    chain = _observers(engine, observers, progress, record_to, checkpoint, every)
+    chain = _observers(observers, progress, record_to, checkpoint, every)
     if not chain:
         done = engine._advance(stop, limit)
         if until is not None and done != limit:  # stopped by the clock, not by the count
             engine._settle(until)
         return done
     stream = next((o for o in chain if isinstance(o, EventStream)), None)
+    keeper = next((o for o in chain if isinstance(o, Checkpointer)), None)
     plan = RunPlan(
         until,
         limit,
@@ -116,24 +120,31 @@ def drive(
         engine.time,
         engine._units(),
         engine.record,
-        every,
+        None if keeper is None else keeper.every,
         None if stream is None else str(stream.path.absolute()),
     )
     return _drive_chunks(engine, plan, stop, chain, stream)
 
 
-def _observers(engine, observers, progress, record_to, checkpoint, every) -> list[Observer]:
-    """The run's observers in the order they are served: stream, checkpointer, progress bar, the user's."""
+#: The order in which observers are served: the stream takes each chunk before a checkpoint refers to it.
+_RANK = {EventStream: 0, Checkpointer: 1}
+
+
+def _observers(observers, progress, record_to, checkpoint, every) -> list[Observer]:
+    """The run's observers in the order they are served: stream, checkpointer, then the rest as given."""
+    if observers is None:
+        observers = ()
+    if isinstance(observers, Observer) or callable(observers) or isinstance(observers, (str, bytes)):
+        msg = f"observers must be a list of observers, got {type(observers).__name__}; wrap it: observers=[...]"
+        raise InvalidArgumentError(msg)
     chain: list[Observer] = []
-    stream = None
     if record_to is not None:
-        stream = EventStream(record_to)
-        chain.append(stream)
+        chain.append(EventStream(record_to))
     if checkpoint is not None:
-        chain.append(Checkpointer(checkpoint, every, stream))
+        chain.append(Checkpointer(checkpoint, every))
     if progress:
         chain.append(ProgressBar())
-    for k, observer in enumerate(observers or ()):
+    for k, observer in enumerate(observers):
         if isinstance(observer, Observer):
             chain.append(observer)
         elif callable(observer):
@@ -141,9 +152,17 @@ def _observers(engine, observers, progress, record_to, checkpoint, every) -> lis
         else:
             msg = f"observers[{k}] must be a discsim Observer or a callable, got {type(observer).__name__}"
             raise InvalidArgumentError(msg)
-    if stream is not None and checkpoint is not None and stream.path.absolute() == chain[1].path.absolute():
-        msg = f"record_to and checkpoint must be two different files, got {stream.path} twice"
+    chain.sort(key=lambda observer: _RANK.get(type(observer), 2))  # stable: the rest keep their order
+    streams = [o for o in chain if isinstance(o, EventStream)]
+    keepers = [o for o in chain if isinstance(o, Checkpointer)]
+    if len(streams) > 1 or len(keepers) > 1:
+        msg = "a run streams to one file and checkpoints to one file at most"
         raise InvalidArgumentError(msg)
+    if streams and keepers:
+        keepers[0].stream = streams[0]
+        if streams[0].path.absolute() == keepers[0].path.absolute():
+            msg = f"record_to and checkpoint must be two different files, got {streams[0].path} twice"
+            raise InvalidArgumentError(msg)
     return chain
 
 
@@ -152,17 +171,25 @@ def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], str
     for observer in chain:  # every check before anything changes
         observer.check(engine, plan)
     wants_events = any(observer.wants_events for observer in chain)
-    recording = engine.record
-    keep = recording and stream is None  # the log stays in memory (else the stream takes it)
+    keep = engine.record and stream is None  # the log stays in memory (else the stream takes it)
     log = engine._log
+    before = (engine._stream, engine._run_id)
     started: list[Observer] = []
     done = 0
     completed = False
     try:
-        engine.record = recording or wants_events  # the loop logs only when record is on
-        for observer in chain:
-            observer.start(engine, plan)
-            started.append(observer)
+        engine._recording = wants_events  # the loop logs for the observers, whatever record says
+        try:
+            for observer in chain:
+                observer.start(engine, plan)
+                started.append(observer)
+        except BaseException:
+            for observer in reversed(started):  # nothing has run: leave no file and no trace behind
+                observer.finish(engine, False)
+                observer.undo_start()
+            engine._stream, engine._run_id = before
+            started = []
+            raise
         if not keep:
             log.clear()  # what the stream wanted of it, it has taken
         mark = len(log)
@@ -181,13 +208,17 @@ def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], str
             if not keep:
                 log.clear()
             mark = len(log)
+            units = engine._units()
             for observer in chain:
                 observer.update(engine, events, k, finishing)
+            if engine._units() != units:
+                msg = "an observer advanced the engine (step() or run() inside a run); observers may only look"
+                raise InvalidArgumentError(msg)
             if finishing:
                 break
         completed = True
     finally:
-        engine.record = recording
+        engine._recording = False
         for observer in reversed(started):
             observer.finish(engine, completed)
     return done

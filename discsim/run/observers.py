@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from discsim.errors import CheckpointError
+from discsim._validate import is_count
+from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.events import EVENT_DTYPE
 from discsim.io.checkpoints import write_checkpoint
 from discsim.io.container import RecordWriter, read_state
@@ -57,6 +58,9 @@ class Observer:
     def finish(self, engine, completed: bool) -> None:
         """The run ends: ``completed`` is False when an exception (Ctrl-C included) stopped it."""
 
+    def undo_start(self) -> None:
+        """Undo what :meth:`start` left behind (a new file), when another observer's start failed."""
+
 
 class Callback(Observer):
     """Calls ``fn(engine, events)`` after every chunk of at most ``every`` units of work.
@@ -75,11 +79,9 @@ class Callback(Observer):
 
     def __init__(self, fn, every: int | None = None):
         if not callable(fn):
-            msg = f"Callback needs a callable, got {type(fn).__name__}"
-            raise TypeError(msg)
-        if every is not None and (isinstance(every, bool) or int(every) != every or every < 1):
-            from discsim.errors import InvalidArgumentError
-
+            msg = f"Callback needs a callable fn(engine, events), got {type(fn).__name__}"
+            raise InvalidArgumentError(msg)
+        if every is not None and (not is_count(every) or every == 0):
             msg = f"every must be a positive integer, got {every!r}"
             raise InvalidArgumentError(msg)
         self.fn = fn
@@ -99,7 +101,7 @@ class ProgressBar(Observer):
     def start(self, engine, plan) -> None:
         self._by_time = plan.limit is None
         total = plan.until - plan.start_time if self._by_time else plan.limit
-        self._context = progress_bar(total, self._by_time)
+        self._context = progress_bar(total, self._by_time, unit=engine.unit, rate=engine.rate_count)
         self._bar = self._context.__enter__()
         self._bar.start(engine.counts[engine.rate_count])
         self._time = engine.time
@@ -132,10 +134,21 @@ class EventStream(Observer):
         self._writer: RecordWriter | None = None
         self._pending: list[np.ndarray] = []
         self._held = 0
+        self._created = False
+        self._time = None  # the engine's time after the last chunk handed over
 
     def check(self, engine, plan) -> None:
         stream, logged = engine._stream, engine._event_count()
+        if not self.path.parent.is_dir():
+            msg = f"cannot write the event log record_to={str(self.path)!r}: no folder {self.path.parent}"
+            raise FileNotFoundError(msg)
         if not self.path.exists():
+            if stream is not None and Path(stream["path"]) == self.path.absolute():
+                msg = (
+                    f"{self.path}: this run's event log is missing (moved or deleted); pass its new place "
+                    "(resume(..., record_to=...)), or stream to another file to start a new log"
+                )
+                raise CheckpointError(msg)
             return
         if stream is None:
             msg = (
@@ -174,6 +187,7 @@ class EventStream(Observer):
             engine._run_id = uuid.uuid4().hex
         meta, arrays = stream_header(discs, engine.box, start, engine._run_id, base)
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
+        self._created = True
         engine._stream = {
             "path": str(self.path.absolute()),
             "run_id": engine._run_id,
@@ -192,13 +206,14 @@ class EventStream(Observer):
 
     def update(self, engine, events, done, finishing) -> None:
         self._hold(events)
+        self._time = engine.time
         if self._held >= engine.stream_chunk:
             self.flush(engine)
 
     def flush(self, engine) -> None:
         """Write the events held as one chunk, stamped with the time it covers up to."""
         records = np.concatenate(self._pending) if self._pending else np.zeros(0, dtype=EVENT_DTYPE)
-        self._writer.append(records, {"time": engine.time})
+        self._writer.append(records, {"time": engine.time if self._time is None else self._time})
         self._pending, self._held = [], 0
         engine._stream = {**engine._stream, "records": self._writer.records, "end": self._writer.end}
 
@@ -207,9 +222,15 @@ class EventStream(Observer):
         self._writer.sync()
 
     def finish(self, engine, completed) -> None:
-        if completed:
-            self.flush(engine)
-        self._writer.close()
+        try:
+            if completed or self._held:  # the chunks handed over were processed whole: keep them
+                self.flush(engine)
+        finally:
+            self._writer.close()
+
+    def undo_start(self) -> None:
+        if self._created:
+            self.path.unlink(missing_ok=True)
 
 
 class Checkpointer(Observer):
@@ -221,10 +242,14 @@ class Checkpointer(Observer):
     """
 
     def __init__(self, path, every: int | None = None, stream: EventStream | None = None):
+        if every is not None and (not is_count(every) or every == 0):
+            msg = f"checkpoint_every must be a positive integer, got {every!r}"
+            raise InvalidArgumentError(msg)
         self.path = Path(path)
         self.every = every
         self.stream = stream
         self._since = 0
+        self._created = False
 
     def check(self, engine, plan) -> None:
         if not self.path.parent.is_dir():
@@ -241,7 +266,12 @@ class Checkpointer(Observer):
 
     def start(self, engine, plan) -> None:
         self._plan = plan
+        self._created = not self.path.exists()
         self._write(engine, finished=False)
+
+    def undo_start(self) -> None:
+        if self._created:
+            self.path.unlink(missing_ok=True)
 
     def next_stop(self, engine) -> int | None:
         return None if self.every is None else self.every - self._since

@@ -10,10 +10,11 @@ __all__ = ["progress_bar"]
 
 
 class _Bar:
-    """Wraps a tqdm bar (or prints plain lines) and shows collisions per second."""
+    """Wraps a tqdm bar (or prints plain lines) and shows a rate (collisions, or detections, per second)."""
 
-    def __init__(self, total, by_time: bool):
+    def __init__(self, total, by_time: bool, unit: str = "events", rate: str = "collisions"):
         self._start = time.perf_counter()
+        self._rate_name = rate
         self._collisions0 = None
         self._by_time = by_time
         try:
@@ -28,7 +29,7 @@ class _Bar:
                 bar_format = "{l_bar}{bar}| t = {n:.4g} / {total:.4g} [{elapsed}<{remaining}{postfix}]"
                 self._tqdm = tqdm(total=total, dynamic_ncols=True, file=sys.stderr, bar_format=bar_format)
             else:
-                self._tqdm = tqdm(total=total, unit=" events", unit_scale=True, dynamic_ncols=True, file=sys.stderr)
+                self._tqdm = tqdm(total=total, unit=f" {unit}", unit_scale=True, dynamic_ncols=True, file=sys.stderr)
 
     def start(self, collisions: int) -> None:
         """Count collisions per second from ``collisions`` (the engine's count when the run starts)."""
@@ -43,12 +44,12 @@ class _Bar:
         rate = (collisions - self._collisions0) / elapsed
         if self._tqdm is not None:
             self._tqdm.update(amount)
-            self._tqdm.set_postfix_str(f"{rate:,.0f} collisions/s", refresh=False)
+            self._tqdm.set_postfix_str(f"{rate:,.0f} {self._rate_name}/s", refresh=False)
             return
         self._done += amount
         if elapsed - self._last_print >= 1.0:
             self._last_print = elapsed
-            print(f"{self._done:.6g} / {self._total:.6g} ({rate:,.0f} collisions/s)", file=sys.stderr)
+            print(f"{self._done:.6g} / {self._total:.6g} ({rate:,.0f} {self._rate_name}/s)", file=sys.stderr)
 
     def close(self) -> None:
         if self._tqdm is not None:
@@ -56,9 +57,9 @@ class _Bar:
 
 
 @contextmanager
-def progress_bar(total, by_time: bool):
-    """A bar over ``total`` units of simulated time (``by_time``) or events."""
-    bar = _Bar(total, by_time)
+def progress_bar(total, by_time: bool, unit: str = "events", rate: str = "collisions"):
+    """A bar over ``total`` units of simulated time (``by_time``) or of work (``unit``), with ``rate`` per second."""
+    bar = _Bar(total, by_time, unit, rate)
     try:
         yield bar
     finally:

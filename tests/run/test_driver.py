@@ -105,3 +105,133 @@ def test_ds_plot_is_imported_lazily():
     assert out.stdout.strip() == "ok"
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         ds.nothing  # noqa: B018
+
+
+def test_saving_inside_an_observer_keeps_the_engines_own_record_setting(make, tmp_path):
+    """The driver records for its observers without touching ``record``: a save mid-run is faithful."""
+    path = tmp_path / "mid.dsc"
+    sim = make(record=False)
+    seen = []
+    sim.run(until=2.0, observers=[ds.Callback(lambda s, e: (seen.append(s.record), s.save(path)), every=50)])
+    assert seen and not any(seen)
+    copy = ds.load(path)
+    assert not copy.record and len(copy.events) == 0
+    with pytest.raises(ds.InvalidArgumentError, match="record=True"):
+        copy.trajectory([copy.time])
+
+
+def test_an_infinite_until_with_a_count_is_a_count(make):
+    sim = make()
+    sim.run(until=np.inf, **_limit(sim, 5))
+    assert np.isfinite(sim.time) and np.isfinite(sim.positions).all()
+    discs = ds.Discs([[2.0, 2.0], [2.0, 7.0]], [[1.0, 0.0], [1.0, 0.0]], radii=0.5)  # never meet
+    lonely = ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True)).run(until=np.inf, events=5)
+    assert lonely.time == 0.0 and np.isfinite(lonely.positions).all()
+
+
+def test_built_in_observers_passed_by_hand_are_linked_and_resumable(make, tmp_path):
+    ck, lg = tmp_path / "c.dsc", tmp_path / "e.dse"
+    reference = make(record=False).run(until=2.0)
+
+    class Stop(Exception):
+        pass
+
+    def stop_late(sim, events):
+        if sim.time > 1.2:
+            raise Stop
+
+    sim = make(record=False)
+    with pytest.raises(Stop):
+        sim.run(until=2.0, observers=[ds.Callback(stop_late, every=20), ds.Checkpointer(ck, 25), ds.EventStream(lg)])
+    assert ds.checkpoint_info(ck)["run"]["checkpoint_every"] == 25
+    resumed = ds.resume(ck)
+    assert resumed.positions.tobytes() == reference.positions.tobytes() and resumed.time == reference.time
+    log = ds.read_events(lg)
+    assert len(log.events) == resumed._event_count()
+
+
+def test_a_failing_observer_keeps_the_streamed_events_of_finished_chunks(make, tmp_path):
+    lg = tmp_path / "e.dse"
+    calls = []
+
+    def third_call_fails(sim, events):
+        calls.append(len(events))
+        if len(calls) == 3:
+            raise RuntimeError("boom")
+
+    sim = make(record=False)
+    with pytest.raises(RuntimeError):
+        sim.run(until=5.0, record_to=lg, observers=[ds.Callback(third_call_fails, every=10)])
+    assert len(ds.read_events(lg).events) == sim._event_count() == sum(calls)
+    sim.run(until=5.0, record_to=lg)  # the log goes on
+    plain = make().run(until=5.0)
+    assert ds.read_events(lg).events.tobytes() == plain.events.tobytes()
+
+
+def test_a_failing_observer_start_leaves_no_trace(make, tmp_path):
+    class Bad(Observer):
+        def start(self, engine, plan):
+            raise RuntimeError("no")
+
+    sim = make().run(until=1.0)
+    lg, ck = tmp_path / "e.dse", tmp_path / "c.dsc"
+    with pytest.raises(RuntimeError):
+        sim.run(until=2.0, record_to=lg, checkpoint=ck, observers=[Bad()])
+    assert not lg.exists() and not ck.exists()
+    assert len(sim.events) and sim.time == 1.0  # still in memory, nothing ran
+
+
+def test_resuming_without_the_runs_log_is_refused(tmp_path):
+    ck, lg = tmp_path / "c.dsc", tmp_path / "e.dse"
+    sim = ds.EventDriven(*ds.random_gas(60, 0.3, seed=1), record=False)
+    sim.run(until=1.0, record_to=lg, checkpoint=ck)
+    lg.rename(tmp_path / "moved.dse")
+    with pytest.raises(ds.CheckpointError, match="event log is missing"):
+        ds.load(ck).run(until=2.0, record_to=lg)
+
+
+def test_observers_may_not_advance_the_engine(make):
+    sim = make()
+    with pytest.raises(ds.InvalidArgumentError, match="advanced the engine"):
+        sim.run(until=2.0, observers=[ds.Callback(lambda s, e: s.step(), every=5)])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"until": True}, "until must be a number"),
+        ({"until": "2"}, "until must be a number"),
+        ({"until": 1.0, "checkpoint_every": -3}, "checkpoint_every must be a positive integer"),
+        ({"until": 1.0, "observers": print}, "observers must be a list"),
+        ({"until": 1.0, "record_to": "no/such/folder/e.dse"}, "record_to"),
+    ],
+)
+def test_bad_run_arguments_are_named(make, kwargs, match):
+    sim = make()
+    with pytest.raises((ds.DiscsimError, FileNotFoundError), match=match):
+        sim.run(**kwargs)
+    assert sim.time == 0.0
+
+
+def test_an_exception_inside_the_loop_marks_the_engine_unusable(make, monkeypatch):
+    sim = make()
+    if sim.unit == "events":
+        backend = sim._backend
+
+        def interrupted(*args, **kwargs):
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(backend, "advance", interrupted)
+    else:
+
+        def interrupted(*args, **kwargs):
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(sim._policy, "frame", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sim.run(until=1.0)
+    monkeypatch.undo()
+    with pytest.raises(ds.DiscsimError, match="interrupted inside its event loop"):
+        sim.run(until=2.0)
+    with pytest.raises(ds.DiscsimError, match="ds.resume"):
+        sim.save("never.dsc")

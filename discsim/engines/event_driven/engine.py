@@ -14,6 +14,7 @@ import numpy as np
 
 from discsim.cells import CellGrid
 from discsim.engines.base import Engine
+from discsim.engines.event_driven.protocol import Backend
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.errors import CheckpointError, InvalidArgumentError
@@ -24,8 +25,8 @@ from discsim.scene import Scene
 __all__ = ["BACKENDS", "EventDriven"]
 
 INF = math.inf
-#: The backends of the event loop, by name.
-BACKENDS = {"python": PythonBackend}
+#: The backends of the event loop, by name: each meets :class:`~discsim.engines.event_driven.protocol.Backend`.
+BACKENDS: dict[str, type[Backend]] = {"python": PythonBackend}
 
 
 class EventDriven(Engine):
@@ -98,23 +99,35 @@ class EventDriven(Engine):
         if queue not in QUEUES:
             msg = f"queue must be one of {sorted(QUEUES)}, got {queue!r}"
             raise InvalidArgumentError(msg)
-        if backend not in BACKENDS:
+        if not isinstance(backend, str) or backend not in BACKENDS:
             msg = f"backend must be one of {sorted(BACKENDS)}, got {backend!r}"
             raise InvalidArgumentError(msg)
         super().__init__(scene, record)
-        n = len(scene)
-        diameter = 2.0 * float(scene.discs.radii.max()) if n else 1.0
-        if cell_size is None:
-            grid = CellGrid(scene.box, diameter, max_cells=4 * n + 9)
-        else:
-            if not (isinstance(cell_size, (int, float, np.integer, np.floating)) and diameter <= cell_size < INF):
-                msg = f"cell_size {cell_size!r} is not finite or is below the largest disc diameter {diameter!r}"
-                raise InvalidArgumentError(msg)
-            grid = CellGrid(scene.box, float(cell_size), what="the cell_size asked for")
-        self.grid = grid
+        grid = self.grid = self.cell_grid(scene.discs.radii, scene.box, cell_size)
         self.queue_kind = queue
         self.cell_size = cell_size
         self._backend = BACKENDS[backend](scene, grid, queue)
+
+    @staticmethod
+    def cell_grid(radii: np.ndarray, box: Box, cell_size: float | None = None) -> CellGrid:
+        """The engine's cell grid for discs of ``radii`` ``(N,)`` in ``box``.
+
+        Cells are at least the largest diameter a side, grown where needed so
+        that there are at most ``4 N + 9`` of them; or ``cell_size`` a side at
+        least, when given (never below the largest diameter).
+
+        Raises:
+            InvalidArgumentError: if ``cell_size`` is not finite or is below the largest diameter.
+            BoxTooSmallError: if a periodic box has fewer than 3 cells a side.
+        """
+        n = len(radii)
+        diameter = 2.0 * float(np.max(radii)) if n else 1.0
+        if cell_size is None:
+            return CellGrid(box, diameter, max_cells=4 * n + 9)
+        if not (isinstance(cell_size, (int, float, np.integer, np.floating)) and diameter <= cell_size < INF):
+            msg = f"cell_size {cell_size!r} is not finite or is below the largest disc diameter {diameter!r}"
+            raise InvalidArgumentError(msg)
+        return CellGrid(box, float(cell_size), what="the cell_size asked for")
 
     # --- the checkpoint's protocol -------------------------------------------------------
     def state(self) -> EventDrivenState:
@@ -159,16 +172,20 @@ class EventDriven(Engine):
 
     def _units(self) -> int:
         """Physical events (collisions plus wall hits) processed since the start."""
-        counts = self._backend._counts
+        counts = self._backend.counts()
         return counts["collisions"] + counts["wall_hits"]
 
     _event_count = _units  # every physical event is one log record
 
     def _advance(self, until: float, limit: int | None) -> int:
-        log = self._log if self.record else None
-        if until != INF:
-            return self._backend.advance(until, limit, log)
-        return self._advance_open(limit, log)
+        log = self._log if self._logging else None
+        try:
+            if until != INF:
+                return self._backend.advance(until, limit, log)
+            return self._advance_open(limit, log)
+        except BaseException as exc:  # half-way through an event: the state cannot be trusted
+            self._broken = f"{type(exc).__name__} at time {self.time!r}"
+            raise
 
     def _advance_open(self, limit: int | None, log) -> int:
         """:meth:`_advance` with no time limit: also stop when no disc can ever hit anything again.
@@ -185,10 +202,10 @@ class EventDriven(Engine):
         done, start = 0, self.time
         budget = 64 + 16 * len(self.discs)
         while True:
-            crossings = backend._counts["cell_crossings"]
+            crossings = backend.counts()["cell_crossings"]
             k = backend.advance(INF, None if limit is None else limit - done, log, budget)
             done += k
-            if done == limit or backend._counts["cell_crossings"] - crossings < budget:
+            if done == limit or backend.counts()["cell_crossings"] - crossings < budget:
                 return done  # the event limit, or nothing left in the queue
             if k == 0:
                 if self._never_again():
@@ -297,16 +314,18 @@ class EventDriven(Engine):
         if elapsed <= 0:
             msg = "pressure() needs a run of positive duration"
             raise InvalidArgumentError(msg)
-        return (self.kinetic_energy() + self._backend._virial / (2.0 * elapsed)) / self.box.area
+        return (self.kinetic_energy() + self._backend.virial / (2.0 * elapsed)) / self.box.area
 
     def step(self) -> Event | None:
         """Process events up to and including the next collision or wall hit.
 
         Returns:
             The :class:`~discsim.events.Event` processed, or None if no disc
-            will ever hit anything (see ``events`` in :meth:`run` for how a
-            periodic box proves that).
+            will ever hit anything (in a periodic box that is proven when every
+            pair drifts alike, or moves relative to itself only along x or only
+            along y and misses; see :meth:`_never_again`).
         """
+        self._check_usable()
         if self._advance(INF, 1) == 0:
             return None
         t, kind, i, j = self._backend.last_event()

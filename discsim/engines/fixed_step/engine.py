@@ -392,6 +392,7 @@ class FixedStep(Engine):
             >>> sim.velocities.tolist()
             [[-2.0, 0.0]]
         """
+        self._check_usable()
         return self._frame()
 
     def _frame(self) -> list[Event]:
@@ -399,8 +400,12 @@ class FixedStep(Engine):
         self._policy.check(paths, self.dt)
         k = tally.counts["frames"] + 1
         t = self.frame_time(k)
-        tally.log = self._log if self.record else None
-        events = self._policy.frame(paths, tally, self._frame_time, t)
+        tally.log = self._log if self._logging else None
+        try:
+            events = self._policy.frame(paths, tally, self._frame_time, t)
+        except BaseException as exc:  # half-way through a frame: the state cannot be trusted
+            self._broken = f"{type(exc).__name__} in frame {k}"
+            raise
         self._frame_time = t
         self.time = t
         tally.counts["frames"] = k
@@ -450,8 +455,8 @@ class FixedStep(Engine):
         """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
         return self._paths.velocities.copy()
 
-    def frame_time(self, k: int) -> float:
-        """The time of frame ``k`` (frame 0 is the start)."""
+    def frame_time(self, k):
+        """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""
         if self._by_rate:
             return self.start_time + k / self.frame_rate
         return self.start_time + k * self.dt
@@ -465,7 +470,4 @@ class FixedStep(Engine):
             >>> sim.run(until=0.6).frame_times().tolist(), sim.time
             ([0.0, 0.25, 0.5], 0.6)
         """
-        k = np.arange(self.frames + 1)
-        if self._by_rate:
-            return self.start_time + k / self.frame_rate
-        return self.start_time + k * self.dt
+        return self.frame_time(np.arange(self.frames + 1))

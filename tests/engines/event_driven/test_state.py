@@ -38,8 +38,18 @@ def test_a_state_of_another_version_or_shape_is_refused():
 
 
 def test_backends_are_named_and_checked():
+    from discsim.engines.event_driven import BACKENDS
+    from discsim.engines.event_driven.protocol import Backend
+
     discs, box = ds.random_gas(20, 0.3, seed=1)
-    assert ds.EventDriven(discs, box).backend == "python"
+    sim = ds.EventDriven(discs, box)
+    assert sim.backend == "python"
+    for make_backend in BACKENDS.values():  # each meets the protocol the front class uses, once started
+        backend = make_backend(sim.scene, sim.grid, "calendar")
+        backend.start()
+        assert isinstance(backend, Backend)
+    with pytest.raises(ds.InvalidArgumentError, match="backend must be one of"):
+        ds.EventDriven(discs, box, backend=["python"])
     with pytest.raises(ds.InvalidArgumentError, match="backend must be one of \\['python'\\], got 'fortran'"):
         ds.EventDriven(discs, box, backend="fortran")
 

@@ -64,14 +64,13 @@ QUEUES = {"calendar": CalendarEventQueue, "sorted": EventQueue, "heap": HeapEven
 
 
 class PythonBackend:
-    """The event loop in pure Python, behind the backend protocol of the event-driven engine.
+    """The event loop in pure Python, behind :class:`~discsim.engines.event_driven.protocol.Backend`.
 
-    The protocol (the front class :class:`~discsim.engines.event_driven.EventDriven` uses only this):
     :meth:`start` (a fresh run from the scene's discs at time 0) or :meth:`load` (a run state),
     :meth:`advance` (process events), :meth:`export` (the run state), and cheap reads: ``time``,
     :meth:`counts`, :meth:`positions`, :meth:`unwrapped_positions`, :meth:`velocities`,
     :meth:`last_event`, ``max_queue``, ``max_overlap``, ``virial``, :meth:`queue_size`,
-    :meth:`queue_storage`.
+    :meth:`queue_storage`. The front class uses nothing else.
 
     Args:
         scene: the validated scene.
@@ -264,7 +263,8 @@ class PythonBackend:
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
         """Process events with time <= ``until``; stop after ``limit`` physical events (None: no limit).
 
-        Also returns after ``crossings`` cell crossings (None: no such limit).
+        Also returns after ``crossings`` cell crossings (None: no such limit): the
+        front class ends open-ended runs in a periodic box with it.
         ``log`` receives each physical event (None: nothing recorded). Returns
         the number of physical events (collisions plus wall hits) processed.
 
@@ -287,6 +287,11 @@ class PythonBackend:
     def counts(self) -> dict[str, int]:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
         return {**self._counts, "predictions": self._predictions()}
+
+    @property
+    def virial(self) -> float:
+        """Sum over collisions of ``dp_i . (r_i - r_j)`` since the start (for the pressure)."""
+        return self._virial
 
     def _records(self) -> np.ndarray:
         """``(N, 6)`` records x, y, vx, vy, t_ref, radius in the caller's numbering (a copy)."""
@@ -539,7 +544,7 @@ class PythonBackend:
         max_queue = self.max_queue
         now, last, virial = None, None, self._virial
         sqrt, max_overlap = math.sqrt, self.max_overlap
-        # Internal times run from the epoch, which moves every REBASE_EVERY physical events.
+        # Internal times run from the epoch, which moves every _rebase_every physical events.
         epoch = self._epoch
         horizon = until - epoch
         rebase_at = self._rebase_every - self._since_rebase

@@ -1,0 +1,74 @@
+"""The protocol every backend of the event-driven engine meets: what the front class uses, and nothing else.
+
+A backend runs the event loop on its own internal forms; what crosses its edge is an
+:class:`~discsim.engines.event_driven.state.EventDrivenState` (plain arrays) and plain numbers.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from discsim.engines.event_driven.state import EventDrivenState
+from discsim.events import EventLog
+
+__all__ = ["Backend"]
+
+
+@runtime_checkable
+class Backend(Protocol):
+    """An event-driven backend, built as ``Backend(scene, grid, queue)`` and then started or loaded.
+
+    Attributes:
+        name: the backend's name (``EventDriven(..., backend=name)``).
+        time: the current simulated time (the front class sets it when a run stops on time).
+        max_queue: most events pending at once. max_overlap: deepest overlap at a contact
+            (settable). virial: sum over collisions of ``dp_i . (r_i - r_j)``.
+    """
+
+    name: str
+    time: float
+    max_queue: int
+    max_overlap: float
+
+    @property
+    def virial(self) -> float: ...
+
+    def start(self) -> None:
+        """A fresh run at time 0 from the scene's discs."""
+
+    def load(self, state: EventDrivenState) -> None:
+        """Take over ``state``."""
+
+    def export(self) -> EventDrivenState:
+        """The run state (new arrays, caller's numbering)."""
+
+    def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
+        """Process events at times <= ``until``, at most ``limit`` physical events (None: no limit), returning
+        after ``crossings`` cell crossings if given; log each physical event in ``log`` (None: none).
+        Returns the physical events processed."""
+
+    def counts(self) -> dict[str, int]:
+        """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
+
+    def positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time``, not wrapped."""
+
+    def unwrapped_positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time``, followed across the periodic edges."""
+
+    def velocities(self) -> np.ndarray:
+        """``(N, 2)`` velocities at ``time``."""
+
+    def last_event(self) -> tuple[float, int, int, int] | None:
+        """``(time, kind, i, j)`` of the last physical event, or None."""
+
+    def queue_size(self) -> int:
+        """Events pending now."""
+
+    def queue_storage(self) -> int:
+        """Entries the queue holds in memory, dead ones included."""
+
+    def _check(self) -> None:
+        """Assert the backend's own invariants."""

@@ -11,6 +11,7 @@ policies' queries: the pairs near each other at some positions, and the discs ne
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 
 import numpy as np
 
@@ -24,7 +25,7 @@ __all__ = ["BROAD_PHASE_CLASSES", "AllPairs", "BroadPhase", "CellTable", "Verlet
 _ALL_PAIRS_BLOCK = 1 << 21
 
 
-class BroadPhase:
+class BroadPhase(ABC):
     """Candidate pairs as chunks ``(i, j, d)``: int arrays ``(P,)`` and ``d`` ``(P, 2)`` the minimum-image
     ``pos[j] - pos[i]``, pairs that pass through each other left out.
     """
@@ -35,17 +36,17 @@ class BroadPhase:
         self.shapes = shapes
         self.box = shapes.box
 
+    @abstractmethod
     def frame_pairs(self, pos: np.ndarray, counts: dict[str, int]):
         """Chunks of the pairs that may overlap at ``pos`` (the positions at a frame)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def pairs_within(self, pos: np.ndarray, reach: float):
         """Chunks holding every pair nearer than ``reach`` (length) at ``pos``."""
-        raise NotImplementedError
 
+    @abstractmethod
     def table(self, pos: np.ndarray, reach: float):
         """A :class:`CellTable` (or :class:`AllDiscs`) of the discs at ``pos``, for box queries."""
-        raise NotImplementedError
 
     def export(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The Verlet list ``(positions, i, j)``; positions ``(0, 2)`` before the first build."""
@@ -54,6 +55,7 @@ class BroadPhase:
 
     def load(self, positions: np.ndarray, i: np.ndarray, j: np.ndarray, built: bool) -> None:
         """Take back a Verlet list from :meth:`export` (``built``: it was built at least once)."""
+        return  # a broad phase without a list has nothing to take back
 
     def _colliding(self, i, j, d):
         """The pairs of ``(i, j, d)`` whose groups collide (all of them when there is no filter)."""

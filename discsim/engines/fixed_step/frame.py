@@ -22,6 +22,7 @@ The interference tests (:func:`walls_crossed`, :func:`segments_cut`) serve the `
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 
 import numpy as np
 
@@ -66,11 +67,8 @@ def segments_cut(pos: np.ndarray, shapes: Shapes, counts: dict[str, int]):
     return np.nonzero(dist < shapes.radii[:, None])
 
 
-class FramePolicy:
-    """The frame shared by the three policies that answer at the frame; its answers are ``"resolve"``'s.
-
-    Subclasses override where the discs are left (:meth:`off_walls`, :meth:`off_segments`,
-    :meth:`off_segment`) and the line of centres of a pair's impulse (:meth:`contact`).
+class Policy(ABC):
+    """What every policy shares: the scene as arrays, the broad phase, and a check before each frame.
 
     Args:
         shapes: the scene as arrays. broad: the broad phase.
@@ -84,6 +82,19 @@ class FramePolicy:
 
     def check(self, paths: Paths, dt: float) -> None:
         """Refuse a frame this policy cannot do (raise before anything changes)."""
+        return  # most policies can do any frame
+
+    @abstractmethod
+    def frame(self, paths: Paths, tally: Tally, t0: float, t: float) -> list[Event]:
+        """Advance every disc from the frame at ``t0`` to the frame at ``t`` and answer what touches."""
+
+
+class FramePolicy(Policy):
+    """The frame shared by the three policies that answer at the frame; its answers are ``"resolve"``'s.
+
+    Subclasses override where the discs are left (:meth:`off_walls`, :meth:`off_segments`,
+    :meth:`off_segment`) and the line of centres of a pair's impulse (:meth:`contact`).
+    """
 
     def frame(self, paths: Paths, tally: Tally, t0: float, t: float) -> list[Event]:
         """Move every disc from the frame at ``t0`` to ``t``, then answer what overlaps there.

@@ -29,12 +29,13 @@ from __future__ import annotations
 
 import heapq
 import math
+from abc import abstractmethod
 
 import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BroadPhase
-from discsim.engines.fixed_step.frame import point_segment_distance, segments_cut, walls_crossed
+from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
 from discsim.errors import InvalidArgumentError
 from discsim.events import Event, EventKind
 from discsim.kernels import (
@@ -52,21 +53,8 @@ __all__ = ["SUB_FRAME_POLICY_CLASSES", "Bisect", "SubFrame", "SubFramePolicy", "
 COLLISION, WALL, SEGMENT = EventKind.COLLISION, EventKind.WALL, EventKind.SEGMENT
 
 
-class SubFramePolicy:
-    """What the two sub-frame policies share: the frame is a :class:`SubFrame`; the policy finds contacts.
-
-    Args:
-        shapes: the scene as arrays. broad: the broad phase.
-    """
-
-    name = ""
-
-    def __init__(self, shapes: Shapes, broad: BroadPhase):
-        self.shapes = shapes
-        self.broad = broad
-
-    def check(self, paths: Paths, dt: float) -> None:
-        """Refuse a frame this policy cannot do (raise before anything changes)."""
+class SubFramePolicy(Policy):
+    """What the two sub-frame policies share: the frame is a :class:`SubFrame`; the policy finds contacts."""
 
     def frame(self, paths: Paths, tally: Tally, t0: float, t: float) -> list[Event]:
         """Advance every disc from the frame at ``t0`` to ``t``, answering each contact at its time.
@@ -77,29 +65,29 @@ class SubFramePolicy:
         return SubFrame(self, paths, tally, t0, t).run()
 
     # --- the policy's part, used by SubFrame ------------------------------------------------------------
+    @abstractmethod
     def detect(self, frame: SubFrame) -> None:
         """Queue the frame's first candidates; set ``frame.table_pos`` and ``frame.table_reach``."""
-        raise NotImplementedError
 
+    @abstractmethod
     def path_box(self, x: float, y: float, ex: float, ey: float) -> tuple[tuple, tuple]:
         """``(lo, hi)``: the corners of the part of a new path from ``(x, y)`` to ``(ex, ey)`` that the tests see."""
-        raise NotImplementedError
 
+    @abstractmethod
     def pair_contact(self, frame, a, m, now, span, dx, dy, dvx, dvy, sigma) -> float | None:
         """When disc ``a``'s new path (from ``now``) touches disc ``m``'s in the frame, or None.
 
         ``(dx, dy)``: the minimum-image ``m - a`` at ``now``; ``(dvx, dvy)``: ``v_m - v_a``;
         ``span``: the time left in the frame; ``sigma``: the contact distance.
         """
-        raise NotImplementedError
 
+    @abstractmethod
     def wall_contact(self, frame, a, wall, now, span, p, v, r, length) -> float | None:
         """When disc ``a`` (coordinate ``p``, velocity ``v`` along the wall's axis) reaches ``wall``, or None."""
-        raise NotImplementedError
 
+    @abstractmethod
     def segment_contact(self, frame, a, k, now, span, x, y, vx, vy, ex, ey, r, ends) -> float | None:
         """When disc ``a``'s new path from ``(x, y)`` at ``now`` to ``(ex, ey)`` touches segment ``k``, or None."""
-        raise NotImplementedError
 
 
 class SubFrame:

@@ -11,6 +11,7 @@ __all__ = [
     "BoxTooSmallError",
     "CheckpointError",
     "DiscsimError",
+    "Interrupted",
     "InvalidArgumentError",
     "InvalidDiscsError",
     "OutsideBoxError",
@@ -54,3 +55,10 @@ class TimeError(DiscsimError, ValueError):
 
 class CheckpointError(DiscsimError, ValueError):
     """A checkpoint or event-log file that is damaged, foreign or incompatible."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a run at the end of a whole event (or frame): the engine is consistent and can go on.
+
+    A ``KeyboardInterrupt``, so ``except KeyboardInterrupt`` catches it, and ``except Exception`` does not.
+    """

@@ -10,7 +10,7 @@ from paths import PACKAGE
 
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
-    "ground": ["model", "kernels", "queue", "errors", "_validate"],
+    "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt"],
     "model": ["scene", "scenarios", "events", "trajectory", "cells"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "__init__", "__main__"],

@@ -17,7 +17,7 @@ from discsim.engines.base import Engine
 from discsim.engines.event_driven.protocol import Backend
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
-from discsim.errors import CheckpointError, InvalidArgumentError
+from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import KIND_NAMES, Event
 from discsim.model import Box, Discs
 from discsim.scene import Scene
@@ -183,6 +183,8 @@ class EventDriven(Engine):
             if until != INF:
                 return self._backend.advance(until, limit, log)
             return self._advance_open(limit, log)
+        except Interrupted:  # Ctrl-C, deferred to the end of a whole event: the state is consistent
+            raise
         except BaseException as exc:  # half-way through an event: the state cannot be trusted
             self._broken = f"{type(exc).__name__} at time {self.time!r}"
             raise

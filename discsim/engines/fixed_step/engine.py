@@ -27,6 +27,7 @@ import math
 
 import numpy as np
 
+from discsim._interrupt import deferred_interrupt
 from discsim._validate import check_count, positive_finite
 from discsim.cells import CellGrid
 from discsim.engines.base import Engine
@@ -35,7 +36,7 @@ from discsim.engines.fixed_step.broad_phase import BROAD_PHASE_CLASSES
 from discsim.engines.fixed_step.frame import FRAME_POLICY_CLASSES
 from discsim.engines.fixed_step.state import FixedStepState
 from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisect
-from discsim.errors import CheckpointError, InvalidArgumentError
+from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
 from discsim.model import Box, Discs
 from discsim.scene import Scene
@@ -298,8 +299,13 @@ class FixedStep(Engine):
         if todo == math.inf:
             msg = "a fixed-step run needs a finite until or a frame count"
             raise InvalidArgumentError(msg)
-        for _ in range(todo):
-            self._frame()
+        done = 0
+        while done < todo:
+            # Ctrl-C ends the run at a whole frame; a handler of the program's own may let it go on.
+            with deferred_interrupt() as interrupted:
+                while done < todo and not interrupted[0]:
+                    self._frame()
+                    done += 1
         return todo
 
     def _frames_due(self, until: float) -> float:
@@ -403,6 +409,8 @@ class FixedStep(Engine):
         tally.log = self._log if self._logging else None
         try:
             events = self._policy.frame(paths, tally, self._frame_time, t)
+        except Interrupted:  # raised only between frames (deferred_interrupt): the state is consistent
+            raise
         except BaseException as exc:  # half-way through a frame: the state cannot be trusted
             self._broken = f"{type(exc).__name__} in frame {k}"
             raise

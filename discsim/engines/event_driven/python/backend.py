@@ -27,6 +27,7 @@ from operator import itemgetter
 
 import numpy as np
 
+from discsim._interrupt import deferred_interrupt
 from discsim.cells import CellGrid
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EventKind, EventLog
@@ -272,16 +273,28 @@ class PythonBackend:
         was): the loop allocates millions of short-lived tuples and never a
         reference cycle, yet each allocation burst would trigger a collection that
         walks memory scattered over the whole system.
+
+        Raises:
+            Interrupted: on Ctrl-C, after the event under way: the state is that of
+                the last whole event, and a later call goes on exactly.
         """
         limit = -1 if limit is None else limit
         crossings = -1 if crossings is None else crossings
-        if not gc.isenabled():
-            return self._process_events(until, limit, crossings, log)
+        collecting = gc.isenabled()
         gc.disable()
         try:
-            return self._process_events(until, limit, crossings, log)
+            done = 0
+            while True:
+                # Ctrl-C ends the loop at a whole event; a handler of the program's own may let it go on.
+                with deferred_interrupt() as interrupted:
+                    done += self._process_events(
+                        until, limit if limit < 0 else limit - done, crossings, log, interrupted
+                    )
+                if not interrupted[0]:
+                    return done
         finally:
-            gc.enable()
+            if collecting:
+                gc.enable()
 
     # --- cheap reads -----------------------------------------------------------------------
     def counts(self) -> dict[str, int]:
@@ -525,8 +538,12 @@ class PythonBackend:
         return predict, predictions
 
     # --- the hot loop ----------------------------------------------------------------------
-    def _process_events(self, until: float, limit: int, crossings: int, log: EventLog | None) -> int:
-        """The hot loop of :meth:`advance` (-1: no limit on ``limit`` or ``crossings``)."""
+    def _process_events(self, until: float, limit: int, crossings: int, log: EventLog | None, interrupted) -> int:
+        """The hot loop of :meth:`advance` (-1: no limit on ``limit`` or ``crossings``).
+
+        Stops before the next event once ``interrupted[0]`` is true
+        (see :func:`~discsim._interrupt.deferred_interrupt`).
+        """
         queue = self._queue
         pop_before = queue.pop_before
         predict = self._predict
@@ -549,6 +566,8 @@ class PythonBackend:
         horizon = until - epoch
         rebase_at = self._rebase_every - self._since_rebase
         while done != limit:
+            if interrupted[0]:  # Ctrl-C: stop between two whole events
+                break
             popped = pop_before(horizon)
             if popped is None:
                 break

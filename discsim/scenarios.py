@@ -162,7 +162,7 @@ def random_gas(
     jitter = 0.0 if n == 1 else 0.49 * slack / math.sqrt(2.0)
     positions = positions + rng.uniform(-jitter, jitter, size=positions.shape)
     if periodic:
-        positions = np.mod(positions, side)
+        positions = Box(side, side, periodic=True).wrap(positions)  # np.mod alone can give the far edge
     else:
         positions = np.clip(positions, radius, side - radius)
     velocities = rng.normal(0.0, math.sqrt(temperature / mass), size=(n, 2))

@@ -208,6 +208,7 @@ def write_state(path, meta: dict, arrays: dict[str, np.ndarray]) -> Path:
 
     Raises:
         TypeError: if ``meta`` or ``arrays`` hold something other than plain data.
+        FileNotFoundError: naming ``path``, if its folder does not exist.
 
     Example:
         >>> import os, tempfile, numpy as np
@@ -220,6 +221,9 @@ def write_state(path, meta: dict, arrays: dict[str, np.ndarray]) -> Path:
     path = Path(path)
     data = _PREFIX.pack(STATE_MAGIC, FORMAT_VERSION) + _encode_block(meta, arrays)
     folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        msg = f"cannot write {str(path)!r}: no folder {str(folder)!r}"
+        raise FileNotFoundError(msg)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
     try:
         with os.fdopen(fd, "wb") as handle:

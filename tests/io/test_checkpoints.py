@@ -505,3 +505,11 @@ def test_save_load_of_a_renumbered_system_continues_bit_for_bit(tmp_path):
     b.run(events=3000)
     assert a.events.tobytes() == b.events.tobytes()
     _assert_same(a, b)
+
+
+def test_saving_into_a_missing_folder_names_the_path_given(tmp_path):
+    sim = ds.EventDriven(*ds.random_gas(20, 0.3, seed=1))
+    target = tmp_path / "no" / "such" / "sim.dsc"
+    with pytest.raises(FileNotFoundError, match=r"cannot write .*sim\.dsc.*no folder"):
+        sim.save(target)
+    assert not (tmp_path / "no").exists()

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import discsim as ds
 
@@ -421,3 +423,46 @@ def test_step_by_step_equals_one_run_when_a_run_ends_early():
         pass
     whole = ds.EventDriven(discs, box).run(events=10)
     assert stepped.time == whole.time and stepped.counts == whole.counts
+
+
+def _never_again_pairwise(sim) -> bool:
+    """The proof of "no pair can ever meet" pair by pair, O(N^2): the oracle of the grouped one."""
+    box, scene = sim.box, sim.scene
+    pos, vel, radii = sim.positions, sim.velocities, sim.discs.radii
+    for i in range(len(pos) - 1):
+        j = np.arange(i + 1, len(pos))
+        dv = vel[j] - vel[i]
+        gap = box.displacement(pos[i], pos[j])
+        reach = (radii[i] + radii[j]) * (1.0 + 1e-9) + 1e-12 * box.size.max()
+        never = (dv == 0.0).all(axis=1) | scene.passes(np.full(len(j), i), j)
+        never |= (dv[:, 0] == 0.0) & (np.abs(gap[:, 0]) > reach)
+        never |= (dv[:, 1] == 0.0) & (np.abs(gap[:, 1]) > reach)
+        if not never.all():
+            return False
+    return True
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    n=st.integers(2, 12),
+    lanes=st.sampled_from(["alike", "x", "y", "mixed", "signed zeros"]),
+    filtered=st.booleans(),
+)
+def test_the_grouped_never_again_proof_agrees_with_the_pairwise_one(seed, n, lanes, filtered):
+    rng = np.random.default_rng(seed)
+    side = 4.0 * max(n, 3)
+    positions = np.column_stack([np.arange(n) * 4.0 + 2.0, rng.uniform(0.0, side, n)])
+    if rng.random() < 0.5:
+        positions = positions[:, ::-1].copy()
+    speeds = rng.choice([-1.0, 0.0, 1.0, 2.0], size=n)
+    velocities = {
+        "alike": np.tile([0.3, -0.7], (n, 1)),
+        "x": np.column_stack([speeds, np.zeros(n)]),
+        "y": np.column_stack([np.zeros(n), speeds]),
+        "mixed": np.column_stack([speeds, rng.choice([0.0, 1.0], size=n)]),
+        "signed zeros": np.column_stack([np.where(rng.random(n) < 0.5, -0.0, 0.0), np.ones(n)]),
+    }[lanes]
+    discs = ds.Discs(positions, velocities, radii=rng.uniform(0.2, 1.5, n), groups=rng.integers(0, 2, n))
+    sim = ds.EventDriven(discs, ds.Box(side, side, periodic=True), pass_through={(0, 1)} if filtered else ())
+    assert sim._never_again() == _never_again_pairwise(sim)

@@ -214,3 +214,35 @@ def test_small_random_gases_run(n, phi, periodic):
 def test_discs_repr_shows_the_radius_range():
     assert repr(ds.Discs([[1, 1], [3, 1]], [[0, 0], [0, 0]], [0.5, 0.7])) == "Discs(n=2, radii in [0.5, 0.7])"
     assert repr(ds.Discs(np.zeros((0, 2)), np.zeros((0, 2)), 1.0)) == "Discs(n=0)"
+
+
+# --- more bad arguments, each named before anything changes (issue 18, part 5) -------------------------
+@pytest.mark.parametrize(
+    ("call", "error", "named"),
+    [
+        (lambda d, b: ds.EventDriven(d, b, record="False"), ds.InvalidArgumentError, "'False'"),
+        (lambda d, b: ds.FixedStep(d, b, record="no"), ds.InvalidArgumentError, "'no'"),
+        (lambda d, b: ds.EventDriven(d, b, queue=["heap"]), ds.InvalidArgumentError, "['heap']"),
+        (lambda d, b: ds.henderson_z(1.2), ds.InvalidArgumentError, "1.2"),
+        (lambda d, b: ds.henderson_z([0.1, float("nan")]), ds.InvalidArgumentError, "nan"),
+        (lambda d, b: ds.enskog_collision_rate(-0.1), ds.InvalidArgumentError, "-0.1"),
+        (lambda d, b: ds.henderson_z("dense"), ds.InvalidArgumentError, "'dense'"),
+        (
+            lambda d, b: ds.compressibility_factor(ds.FixedStep(d, b, dt=0.1).run(until=1.0)),
+            ds.InvalidArgumentError,
+            "FixedStep",
+        ),
+        (
+            lambda d, b: ds.compressibility_factor(
+                ds.EventDriven(ds.Discs(d.positions, np.zeros_like(d.velocities), d.radii), b).run(until=1.0)
+            ),
+            ds.InvalidArgumentError,
+            "kinetic energy is 0",
+        ),
+    ],
+)
+def test_more_bad_arguments_are_named(call, error, named):
+    discs, box = ds.random_gas(20, 0.3, seed=1)
+    with pytest.raises(error) as caught:
+        call(discs, box)
+    assert named in str(caught.value)

@@ -11,7 +11,27 @@ import math
 
 import numpy as np
 
+from discsim.errors import InvalidArgumentError
+
 __all__ = ["contact_value", "enskog_collision_rate", "henderson_z", "speed_cdf", "speed_pdf"]
+
+
+def _packing(value) -> np.ndarray:
+    """``value`` as a float array of packing fractions, each finite and in ``[0, 1)``.
+
+    Raises:
+        InvalidArgumentError: naming the first value outside.
+    """
+    try:
+        eta = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        msg = f"packing_fraction must be a number or an array of numbers, got {value!r}"
+        raise InvalidArgumentError(msg) from exc
+    bad = ~((eta >= 0.0) & (eta < 1.0))  # NaN included
+    if bad.any():
+        msg = f"packing_fraction must lie in [0, 1), got {float(eta[bad].flat[0])!r}"
+        raise InvalidArgumentError(msg)
+    return eta
 
 
 def henderson_z(packing_fraction):
@@ -24,7 +44,7 @@ def henderson_z(packing_fraction):
         >>> round(float(henderson_z(0.5)), 4)
         4.125
     """
-    eta = np.asarray(packing_fraction, dtype=float)
+    eta = _packing(packing_fraction)
     return (1.0 + eta**2 / 8.0) / (1.0 - eta) ** 2
 
 
@@ -37,7 +57,7 @@ def contact_value(packing_fraction):
         >>> float(contact_value(0.0)), round(float(contact_value(0.3)), 6)
         (1.0, 1.772959)
     """
-    eta = np.asarray(packing_fraction, dtype=float)
+    eta = _packing(packing_fraction)
     return (1.0 - 7.0 * eta / 16.0) / (1.0 - eta) ** 2
 
 
@@ -67,7 +87,7 @@ def enskog_collision_rate(packing_fraction, radius: float = 1.0, kT: float = 1.0
     and number density ``n = eta / (pi r^2)``. Each collision involves two
     discs, so the total rate of collisions is ``N rate / 2``.
     """
-    eta = np.asarray(packing_fraction, dtype=float)
+    eta = _packing(packing_fraction)
     sigma = 2.0 * radius
     density = eta / (math.pi * radius**2)
     return 2.0 * sigma * density * contact_value(eta) * np.sqrt(math.pi * kT / mass)

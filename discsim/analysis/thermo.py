@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from discsim.errors import InvalidArgumentError
+
 __all__ = ["compressibility_factor", "packing_fraction"]
 
 
@@ -19,5 +21,17 @@ def packing_fraction(radii: np.ndarray, area: float) -> float:
 
 
 def compressibility_factor(sim) -> float:
-    """``Z = P A / (N kT)`` of an event-driven run (``N kT`` is the kinetic energy)."""
-    return sim.pressure() * sim.box.area / sim.kinetic_energy()
+    """``Z = P A / (N kT)`` of an event-driven run (``N kT`` is the kinetic energy).
+
+    Raises:
+        InvalidArgumentError: if the engine has no ``pressure()`` (``FixedStep`` has none yet) or no
+            kinetic energy (no free disc moves).
+    """
+    if not callable(getattr(sim, "pressure", None)):
+        msg = f"compressibility_factor needs an engine with pressure() (an EventDriven run), got {type(sim).__name__}"
+        raise InvalidArgumentError(msg)
+    energy = sim.kinetic_energy()
+    if energy <= 0.0:
+        msg = "compressibility_factor needs moving discs: the kinetic energy is 0"
+        raise InvalidArgumentError(msg)
+    return sim.pressure() * sim.box.area / energy

@@ -95,6 +95,9 @@ class Engine(ABC):
         self.box = scene.box
         self.segments = scene.segments
         self.pass_through = scene.pass_through
+        if not isinstance(record, (bool, np.bool_)):  # bool("False") would be True
+            msg = f"record must be True or False, got {record!r}"
+            raise InvalidArgumentError(msg)
         self.record = bool(record)
         self.start_time = 0.0
         self._log = EventLog()

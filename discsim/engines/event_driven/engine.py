@@ -96,7 +96,7 @@ class EventDriven(Engine):
 
     def _configure(self, scene: Scene, record: bool, queue: str, cell_size, backend: str) -> None:
         """Check the options and build the grid and the backend (not yet started or loaded)."""
-        if queue not in QUEUES:
+        if not isinstance(queue, str) or queue not in QUEUES:
             msg = f"queue must be one of {sorted(QUEUES)}, got {queue!r}"
             raise InvalidArgumentError(msg)
         if not isinstance(backend, str) or backend not in BACKENDS:

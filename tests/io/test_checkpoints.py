@@ -513,3 +513,35 @@ def test_saving_into_a_missing_folder_names_the_path_given(tmp_path):
     with pytest.raises(FileNotFoundError, match=r"cannot write .*sim\.dsc.*no folder"):
         sim.save(target)
     assert not (tmp_path / "no").exists()
+
+
+@pytest.mark.parametrize(
+    ("field", "damage", "named"),
+    [
+        ("state.ref_positions", lambda a: a[:-1], "ref_positions"),
+        ("state.cell_members", lambda a: np.where(a == a.max(), 10**6, a), "cell_members"),
+        ("state.order", lambda a: np.zeros_like(a), "order"),
+        ("state.queue_time", lambda a: np.where(np.arange(len(a)) == 0, np.nan, a), "queue_time"),
+        ("state.queue_owner", lambda a: a + 10**6, "queue_owner"),
+        ("state.cell", lambda a: (a + 1) % a.max(), "cell"),
+    ],
+)
+def test_a_crafted_checkpoint_with_a_valid_checksum_is_refused_by_name(tmp_path, field, damage, named):
+    """Arrays that do not fit together are refused when loading, not later in the loop (issue 18, part 4)."""
+    path = tmp_path / "sim.dsc"
+    ds.EventDriven(*ds.random_gas(60, 0.4, seed=2)).run(events=300).save(path)
+    meta, arrays = dio.read_state(path)
+    arrays[field] = damage(arrays[field])
+    dio.write_state(path, meta, arrays)  # a fresh, valid checksum over the damaged arrays
+    with pytest.raises(CheckpointError, match=named):
+        ds.load(path)
+
+
+def test_a_crafted_checkpoint_with_a_nan_time_is_refused(tmp_path):
+    path = tmp_path / "sim.dsc"
+    ds.EventDriven(*ds.random_gas(60, 0.4, seed=2)).run(events=300).save(path)
+    meta, arrays = dio.read_state(path)
+    meta["state"]["time"] = float("nan")
+    dio.write_state(path, meta, arrays)
+    with pytest.raises(CheckpointError, match="time"):
+        ds.load(path)

@@ -154,6 +154,7 @@ class EventDriven(Engine):
                 f"{sim.grid.nx} x {sim.grid.ny}"
             )
             raise CheckpointError(msg)
+        state.check(len(scene), len(sim.grid))
         sim._backend.load(state)
         if len(events):
             sim._log.extend(events)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim.engines.base import EngineState
+from discsim.errors import CheckpointError
 
 __all__ = ["EventDrivenState"]
 
@@ -89,6 +90,79 @@ class EventDrivenState(EngineState):
     queue_kind: np.ndarray
     queue_other: np.ndarray
     queue_stamp: np.ndarray
+
+    def check(self, n: int, n_cells: int) -> None:
+        """Refuse a state that cannot belong to ``n`` discs on a grid of ``n_cells`` cells.
+
+        Checks every field's shape and type, that the numbers are finite, that indices lie in range
+        and that the cells and the numbering are permutations of the discs. O(N log N).
+
+        Raises:
+            CheckpointError: naming the field and what is wrong with it.
+        """
+
+        def fail(field: str, what: str) -> None:
+            msg = f"EventDrivenState.{field}: {what}"
+            raise CheckpointError(msg)
+
+        shapes = {
+            "ref_positions": ((n, 2), "f"),
+            "velocities": ((n, 2), "f"),
+            "ref_times": ((n,), "f"),
+            "images": ((n, 2), "i"),
+            "collision_counts": ((n,), "i"),
+            "cell": ((n,), "i"),
+            "cell_members": ((n,), "i"),
+            "cell_sizes": ((n_cells,), "i"),
+            "kept_time": ((n,), "f"),
+            "kept_partner": ((n,), "i"),
+            "kept_stamp": ((n,), "i"),
+            "order": ((n,), "i"),
+        }
+        q = np.shape(self.queue_owner)
+        shapes.update(
+            {
+                name: (q, kind)
+                for name, kind in (
+                    ("queue_owner", "i"),
+                    ("queue_time", "f"),
+                    ("queue_kind", "i"),
+                    ("queue_other", "i"),
+                    ("queue_stamp", "i"),
+                )
+            }
+        )
+        for field, (shape, kind) in shapes.items():
+            value = getattr(self, field)
+            if not isinstance(value, np.ndarray) or value.shape != shape or value.dtype.kind != kind:
+                got = f"{value.dtype} {value.shape}" if isinstance(value, np.ndarray) else type(value).__name__
+                fail(field, f"expected a {'float' if kind == 'f' else 'integer'} array of shape {shape}, got {got}")
+        for field in ("time", "epoch", "virial", "max_overlap", "last_time"):
+            if not isinstance(getattr(self, field), (int, float)) or not np.isfinite(getattr(self, field)):
+                fail(field, f"expected a finite number, got {getattr(self, field)!r}")
+        for field in ("ref_positions", "velocities", "ref_times", "queue_time"):
+            bad = ~np.isfinite(getattr(self, field))
+            if bad.any():
+                fail(field, f"non-finite value {getattr(self, field)[bad].flat[0]!r}")
+        for field in ("order", "cell_members"):
+            if not np.array_equal(np.sort(getattr(self, field)), np.arange(n)):
+                fail(field, f"expected each disc 0..{n - 1} exactly once")
+        if ((self.cell < 0) | (self.cell >= n_cells)).any() or (self.cell_sizes < 0).any():
+            fail("cell", f"cell indices must lie in [0, {n_cells})")
+        listed = (
+            np.repeat(np.arange(n_cells), np.clip(self.cell_sizes, 0, None)) if self.cell_sizes.sum() == n else None
+        )
+        if listed is None or not np.array_equal(listed[np.argsort(self.cell_members)], self.cell):
+            fail("cell_sizes", "the cells' members and the discs' cells disagree")
+        if len(self.queue_owner) > n or len(np.unique(self.queue_owner)) != len(self.queue_owner):
+            fail("queue_owner", "at most one pending event per disc")
+        if ((self.queue_owner < 0) | (self.queue_owner >= n)).any():
+            fail("queue_owner", f"disc indices must lie in [0, {n})")
+        if ((self.queue_kind < 0) | (self.queue_kind > 3)).any():
+            fail("queue_kind", "kinds are 0 (collision), 1 (wall), 2 (crossing) and 3 (segment)")
+        partners = self.queue_other[self.queue_kind == 0]
+        if ((partners < 0) | (partners >= n)).any() or ((self.kept_partner < -1) | (self.kept_partner >= n)).any():
+            fail("queue_other", f"collision partners must lie in [0, {n})")
 
     @property
     def counts(self) -> dict[str, int]:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from discsim.events import EventKind
 from discsim.model import Discs
 from discsim.scene import check_fits
 
@@ -23,19 +22,18 @@ def check(sim) -> None:
       holds at most N events;
     - collision events name a partner, kept collisions a valid partner;
     - the discs fit in the box without overlap (as the constructor checks).
+
+    Raises:
+        AssertionError, or CheckpointError from :meth:`EventDrivenState.check` for the state's own form.
     """
     sim._backend._check()
     state = sim.state()
     n = len(sim.discs)
     grid, box = sim.grid, sim.box
     assert (state.grid_nx, state.grid_ny) == (grid.nx, grid.ny)
-    assert len(state.cell_sizes) == len(grid)
-    assert int(state.cell_sizes.sum()) == n
-    assert sorted(state.cell_members.tolist()) == list(range(n)), "every disc is in exactly one cell"
-    owner_cell = np.repeat(np.arange(len(grid)), state.cell_sizes)
-    listed = np.empty(n, dtype=np.int64)
-    listed[state.cell_members] = owner_cell
-    assert np.array_equal(listed, state.cell), "a disc's cell and the cell's members disagree"
+    # Shapes, finiteness, each disc in exactly one cell and listed there, one event per owner, partners
+    # in range: what a loaded state must satisfy too.
+    state.check(n, len(grid))
     pos = box.wrap(state.positions_at(state.time))
     expected = grid.cells_of(pos)
     tol = 1e-9 * max(grid.lx, grid.ly)
@@ -49,13 +47,8 @@ def check(sim) -> None:
             box.periodic and (y < tol or y > box.height - tol)
         )
         assert inside_x and inside_y, f"disc {i} at {pos[i]} is not in its cell {int(state.cell[i])}"
-    assert len(state.queue_owner) <= n
-    assert len(set(state.queue_owner.tolist())) == len(state.queue_owner), "one pending event per disc"
     now = state.time - state.epoch
     assert (state.queue_time >= now - 1e-12 * max(1.0, state.time)).all(), "an event lies in the past"
-    collisions = state.queue_kind == int(EventKind.COLLISION)
-    assert ((state.queue_other[collisions] >= 0) & (state.queue_other[collisions] < n)).all()
-    assert ((state.kept_partner >= -1) & (state.kept_partner < n)).all()
     moving = np.isfinite(sim.discs.masses) & (state.velocities != 0).any(axis=1)
     pending = np.zeros(n, dtype=bool)
     pending[state.queue_owner] = True

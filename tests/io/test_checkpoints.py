@@ -492,7 +492,7 @@ def test_record_streams_refuse_what_they_cannot_hold(tmp_path):
 
 def test_save_load_of_a_renumbered_system_continues_bit_for_bit(tmp_path):
     """Large systems are numbered internally tile by tile; a checkpoint keeps that numbering."""
-    from discsim.engines.event_driven.python.backend import _RENUMBER_MIN
+    from discsim.engines.event_driven.numbering import RENUMBER_MIN as _RENUMBER_MIN
 
     discs, box = ds.random_gas(_RENUMBER_MIN + 500, 0.3, periodic=False, seed=8)
     shuffled = np.random.default_rng(1).permutation(len(discs))

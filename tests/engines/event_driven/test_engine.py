@@ -346,8 +346,8 @@ def test_cell_crossings_keep_ghost_copies_in_step():
 # --- the internal numbering of large systems -------------------------------------------------
 def test_the_internal_numbering_is_invisible(monkeypatch):
     """A large system numbered tile by tile inside gives the caller the same positions, events and ids."""
-    from discsim.engines.event_driven.python import backend
-    from discsim.engines.event_driven.python.backend import _RENUMBER_MIN
+    from discsim.engines.event_driven import numbering
+    from discsim.engines.event_driven.numbering import RENUMBER_MIN as _RENUMBER_MIN
 
     gas, box = ds.random_gas(_RENUMBER_MIN + 904, 0.3, periodic=True, seed=5)
     n = len(gas)
@@ -359,7 +359,7 @@ def test_the_internal_numbering_is_invisible(monkeypatch):
     assert not np.array_equal(order, np.arange(n)) and sorted(order.tolist()) == list(range(n))
     assert np.abs(np.diff(order)).mean() > n / 10  # far from the identity on a shuffled input
     assert np.array_equal(sim.positions, discs.positions) and np.array_equal(sim.velocities, discs.velocities)
-    monkeypatch.setattr(backend, "_RENUMBER_MIN", 10 * n)
+    monkeypatch.setattr(numbering, "RENUMBER_MIN", 10 * n)
     plain = ds.EventDriven(discs, box)  # the caller's numbering inside too
     assert np.array_equal(plain.state().order, np.arange(n))
     first = [sim.step() for _ in range(2000)]

@@ -29,6 +29,7 @@ import numpy as np
 
 from discsim._interrupt import deferred_interrupt
 from discsim.cells import CellGrid
+from discsim.engines.event_driven.numbering import TILE, fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EventKind, EventLog
 from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
@@ -43,14 +44,10 @@ _RECORD_BYTES = _RECORD.size
 # Positions in a cell's static record (see PythonBackend._make_predictor): the cell's index,
 # its slot in its tile, and the ghost copies of it in other tiles.
 _CELL_INDEX, _SLOT, _GHOSTS = 9, 10, 11
-# Side, in cells, of the square tiles the table of cell members is cut into (see _tile_cells).
-# With a ring of ghost cells a tile holds 12 x 12 = 144 slots, so every slot index is one of
-# CPython's cached small ints and a 3x3 block reads no memory outside its tile.
-_TILE = 10
-# Systems of at least this many discs are numbered internally tile by tile (see internal_order).
-# Smaller ones fit in the caches, gain nothing, and keep the caller's numbering, which then also
-# decides the order of simultaneous events, as the caller would expect.
-_RENUMBER_MIN = 4096
+# Side, in cells, of the square tiles the table of cell members is cut into (see _tile_cells): the
+# tiles of the internal numbering. With a ring of ghost cells a tile holds 12 x 12 = 144 slots, so every
+# slot index is one of CPython's cached small ints and a 3x3 block reads no memory outside its tile.
+_TILE = TILE
 
 INF = math.inf
 # Kinds of queued events, as plain ints for the hot loop (one numbering: EventKind).
@@ -92,52 +89,9 @@ class PythonBackend:
     # --- the protocol --------------------------------------------------------------------
     def start(self) -> None:
         """A fresh run at time 0 from the scene's discs: every moving disc predicted, in internal order."""
-        discs, grid = self.scene.discs, self.grid
-        n = len(discs)
-        order = internal_order(grid, discs.positions) if n >= _RENUMBER_MIN else np.arange(n)
-        cell = grid.cells_of(discs.positions)
-        members = order[np.argsort(cell[order], kind="stable")]  # by cell, then internal number
-        empty_queue = np.zeros(0, dtype=np.int64)
-        self.load(
-            EventDrivenState(
-                time=0.0,
-                epoch=0.0,
-                since_rebase=0,
-                collisions=0,
-                wall_hits=0,
-                cell_crossings=0,
-                stale=0,
-                predictions=0,
-                virial=0.0,
-                max_overlap=0.0,
-                max_queue=0,
-                last_time=0.0,
-                last_kind=-1,
-                last_i=-1,
-                last_j=-1,
-                grid_nx=grid.nx,
-                grid_ny=grid.ny,
-                ref_positions=np.array(discs.positions),
-                velocities=np.array(discs.velocities),
-                ref_times=np.zeros(n),
-                images=np.zeros((n, 2), dtype=np.int64),
-                collision_counts=np.zeros(n, dtype=np.int64),
-                cell=cell,
-                cell_members=members,
-                cell_sizes=np.bincount(cell, minlength=len(grid)).astype(np.int64),
-                kept_time=np.full(n, INF),
-                kept_partner=np.full(n, -1, dtype=np.int64),
-                kept_stamp=np.zeros(n, dtype=np.int64),
-                order=np.asarray(order, dtype=np.int64),
-                queue_owner=empty_queue,
-                queue_time=np.zeros(0),
-                queue_kind=empty_queue,
-                queue_other=empty_queue,
-                queue_stamp=empty_queue,
-            )
-        )
+        self.load(fresh_state(self.scene, self.grid))
         predict, moving = self._predict, self._moving
-        for i in range(n):
+        for i in range(len(moving)):
             if moving[i]:
                 predict(i, 0.0, -1)
         self.max_queue = len(self._queue)
@@ -733,24 +687,6 @@ class PythonBackend:
         self._kept_time[:] = [t - shift for t in self._kept_time]
         self._queue.shift_times(shift)
         self._epoch += shift
-
-
-def internal_order(grid: CellGrid, positions: np.ndarray) -> np.ndarray:
-    """The internal numbering of the discs: tile by tile of ``_TILE`` x ``_TILE`` cells.
-
-    Discs are sorted by tile, then by cell within the tile (stable, so the
-    caller's order stands within a cell). Neighbours then have nearby numbers,
-    and their records, counters and kept collisions share cache lines and
-    pages (figures in docs/performance.md). Returns ``order``, ``(N,)``: internal disc k is
-    the caller's disc ``order[k]``.
-    """
-    if not len(positions):
-        return np.zeros(0, dtype=np.int64)
-    cx, cy = np.divmod(grid.cells_of(positions), grid.ny)
-    tiles_y = -(-grid.ny // _TILE)
-    tile = (cx // _TILE) * tiles_y + cy // _TILE
-    key = (tile * _TILE + cx % _TILE) * _TILE + cy % _TILE
-    return np.argsort(key, kind="stable").astype(np.int64)
 
 
 def _tile_cells(grid: CellGrid, members: list[tuple[int, ...]], periodic: bool):

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from discsim._numba import available as numba_available
+from discsim._numba import resolve_backend
 from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import FixedStep
 from discsim.errors import CheckpointError, DiscsimError
@@ -146,16 +148,18 @@ def _engine_class(meta, path) -> type:
     return ENGINES[engine]
 
 
-def load(path):
+def load(path, *, backend: str | None = None):
     """Load a simulation saved by ``save(path)`` or by ``run(checkpoint=path)``.
 
     The loaded engine continues exactly as the saved one would have: the same
-    events, bit for bit. If the run streamed its log to disk, a later
+    events, bit for bit, under either backend. If the run streamed its log to disk, a later
     ``run(record_to=...)`` on that same file continues it (anything written
     after the checkpoint is cut off first).
 
     Args:
         path: the checkpoint file.
+        backend: the backend to continue with (``"auto"``, ``"python"``, ``"numba"``); None: the one
+            that wrote the file, or ``"auto"`` if that one cannot run here (numba missing).
 
     Returns:
         The engine (:class:`~discsim.EventDriven` or :class:`~discsim.FixedStep`), at the saved time.
@@ -174,6 +178,8 @@ def load(path):
         >>> copy.time == sim.time, copy.counts == sim.counts, copy.queue_kind
         (True, True, 'heap')
     """
+    if backend is not None:
+        resolve_backend(backend, ("python", "numba"), "load")
     meta, arrays = read_state(path)
     engine = _engine_class(meta, path)
     try:
@@ -195,6 +201,8 @@ def load(path):
             events = arrays["events"]
         else:
             scene_meta, settings, state, events = _first_layout(meta, arrays)
+        if backend is not None or (settings.get("backend") == "numba" and not numba_available()):
+            settings = {**settings, "backend": backend or "auto"}
         segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
         scene = Scene(discs, box, segments, [tuple(pair) for pair in scene_meta.get("pass_through", [])])
         sim = engine._restore(scene, settings, state, events, float(meta["start_time"]))
@@ -285,7 +293,7 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
     return scene, new_settings, state, events
 
 
-def resume(path, *, progress: bool = False, record_to=None):
+def resume(path, *, progress: bool = False, record_to=None, backend: str | None = None):
     """Continue the run that wrote checkpoint ``path`` to the end it was given.
 
     Loads the checkpoint and calls ``run`` with the same ``until`` and the
@@ -299,6 +307,7 @@ def resume(path, *, progress: bool = False, record_to=None):
         progress: show a progress bar.
         record_to: the streamed log, if it moved since (default: where the
             run wrote it).
+        backend: as for :func:`load`.
 
     Returns:
         The engine at the end of the run.
@@ -322,7 +331,7 @@ def resume(path, *, progress: bool = False, record_to=None):
     if run is None:
         msg = f"{path} was written by save(), not by run(checkpoint=...): no run to resume; use load() and run()"
         raise CheckpointError(msg)
-    sim = load(path)
+    sim = load(path, backend=backend)
     if run["finished"]:
         return sim
     remaining = None if run["events"] is None else run["events"] - sim._units()

@@ -12,8 +12,10 @@ import math
 
 import numpy as np
 
+from discsim._numba import resolve_backend
 from discsim.cells import CellGrid
 from discsim.engines.base import Engine
+from discsim.engines.event_driven.numba import NumbaBackend
 from discsim.engines.event_driven.protocol import Backend
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
@@ -26,7 +28,7 @@ __all__ = ["BACKENDS", "EventDriven"]
 
 INF = math.inf
 #: The backends of the event loop, by name: each meets :class:`~discsim.engines.event_driven.protocol.Backend`.
-BACKENDS: dict[str, type[Backend]] = {"python": PythonBackend}
+BACKENDS: dict[str, type[Backend]] = {"python": PythonBackend, "numba": NumbaBackend}
 
 
 class EventDriven(Engine):
@@ -51,13 +53,17 @@ class EventDriven(Engine):
         pass_through: pairs of group labels (``discs.groups``) whose discs do
             not collide with each other, e.g. ``{(1, 1)}`` for bullets that
             pass through one another. Free when empty.
-        backend: the event loop: ``"python"`` (the default, pure Python; see
-            :mod:`discsim.engines.event_driven.python`).
+        backend: the event loop: ``"auto"`` (the default: ``"numba"`` when numba
+            imports, else ``"python"``), ``"numba"`` (compiled, from the ``fast`` extra:
+            ``pip install "discsim[fast]"``; :mod:`discsim.engines.event_driven.numba`) or
+            ``"python"`` (pure Python; :mod:`discsim.engines.event_driven.python`). Both give the
+            same events bit for bit and the same checkpoints; ``sim.backend`` names the one that runs.
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
         BoxTooSmallError: if a periodic box has fewer than 3 cells a side.
-        InvalidArgumentError: on an unknown queue or backend, or a bad ``cell_size``.
+        InvalidArgumentError: on an unknown queue or backend, ``backend="numba"`` without numba,
+            or a bad ``cell_size``.
 
     Attributes:
         time (float): the current simulated time.
@@ -89,7 +95,7 @@ class EventDriven(Engine):
         cell_size: float | None = None,
         segments=(),
         pass_through=(),
-        backend: str = "python",
+        backend: str = "auto",
     ):
         self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend)
         self._backend.start()
@@ -99,9 +105,7 @@ class EventDriven(Engine):
         if not isinstance(queue, str) or queue not in QUEUES:
             msg = f"queue must be one of {sorted(QUEUES)}, got {queue!r}"
             raise InvalidArgumentError(msg)
-        if not isinstance(backend, str) or backend not in BACKENDS:
-            msg = f"backend must be one of {sorted(BACKENDS)}, got {backend!r}"
-            raise InvalidArgumentError(msg)
+        backend = resolve_backend(backend, BACKENDS, "EventDriven")
         super().__init__(scene, record)
         grid = self.grid = self.cell_grid(scene.discs.radii, scene.box, cell_size)
         self.queue_kind = queue
@@ -146,7 +150,7 @@ class EventDriven(Engine):
     def _restore(cls, scene, settings, state, events, start_time) -> EventDriven:
         sim = cls.__new__(cls)
         sim._configure(
-            scene, settings["record"], settings["queue"], settings["cell_size"], settings.get("backend", "python")
+            scene, settings["record"], settings["queue"], settings["cell_size"], settings.get("backend", "auto")
         )
         if (state.grid_nx, state.grid_ny) != (sim.grid.nx, sim.grid.ny):
             msg = (

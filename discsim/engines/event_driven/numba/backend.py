@@ -1,0 +1,386 @@
+"""The compiled backend of the event-driven engine: the Python backend's algorithm, compiled by numba.
+
+State lives in plain arrays in the internal numbering (see :mod:`discsim.engines.event_driven.numba.loop`
+for their layout); :meth:`NumbaBackend.load` builds them from an
+:class:`~discsim.engines.event_driven.state.EventDrivenState` and :meth:`NumbaBackend.export` gives one
+back, the same state the Python backend would export after the same events. The loop runs in chunks of at
+most ``BUDGET`` queue pops, so Ctrl-C is seen within milliseconds and lands between two whole events.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from discsim._interrupt import deferred_interrupt
+from discsim.cells import CellGrid
+from discsim.engines.event_driven.numbering import fresh_state
+from discsim.engines.event_driven.state import EventDrivenState
+from discsim.events import EVENT_DTYPE, EventKind, EventLog
+from discsim.scene import Scene
+
+__all__ = ["NumbaBackend"]
+
+#: Queue pops per call of the compiled loop: how soon Ctrl-C is seen (about 10-50 ms of work).
+BUDGET = 1 << 16
+#: Rows of the buffer the compiled loop writes the event log into, per call.
+LOG_ROWS = 1 << 14
+# Physical events between moves of the internal clock's epoch (as the Python backend).
+_REBASE_EVENTS = 1 << 18
+_COLLISION = int(EventKind.COLLISION)
+
+
+def _loop():
+    """The compiled functions (imported on first use: importing numba takes a while)."""
+    from discsim.engines.event_driven.numba import loop
+
+    return loop
+
+
+class NumbaBackend:
+    """The event loop compiled by numba, behind :class:`~discsim.engines.event_driven.protocol.Backend`.
+
+    Args:
+        scene: the validated scene.
+        grid: the cell grid (cells at least one largest diameter a side).
+        queue: the queue the caller asked for; this backend always uses one array-based binary heap,
+            which pops events in the same ``(time, disc)`` order as every Python queue.
+    """
+
+    name = "numba"
+
+    def __init__(self, scene: Scene, grid: CellGrid, queue: str):
+        self.scene = scene
+        self.box = scene.box
+        self.grid = grid
+        self.queue_kind = queue
+        self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
+        self._lp = _loop()
+        box = self.box
+        nx, ny = grid.nx, grid.ny
+        self._col_lo = np.append(np.arange(nx) * grid.lx, box.width)
+        self._row_lo = np.append(np.arange(ny) * grid.ly, box.height)
+        segments = scene.segments
+        if segments:
+            self._seg = np.array([[*s.p0.tolist(), *s.p1.tolist()] for s in segments], dtype=np.float64)
+            reach = float(np.max(scene.discs.radii)) if len(scene) else 0.0
+            near = grid.segments_by_cell(segments, reach)
+        else:
+            self._seg = np.zeros((0, 4))
+            near = [()] * len(grid)
+        sizes = np.array([len(s) for s in near], dtype=np.int64)
+        self._seg_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        self._seg_idx = np.array([k for s in near for k in s], dtype=np.int64)
+        self._events = None
+
+    # --- the protocol --------------------------------------------------------------------
+    def start(self) -> None:
+        """A fresh run at time 0 from the scene's discs: every moving disc predicted, in internal order."""
+        self.load(fresh_state(self.scene, self.grid))
+        self._lp.predict_all(*self._predict_args())
+
+    def load(self, state: EventDrivenState) -> None:
+        """Take over ``state`` (caller's numbering), building the internal arrays from it."""
+        lp, discs = self._lp, self.scene.discs
+        n = len(discs)
+        order = np.asarray(state.order, dtype=np.int64)
+        rank = np.empty(n, dtype=np.int64)
+        rank[order] = np.arange(n)
+        self._order, self._rank = order, rank
+        rec = np.empty((n, 8))
+        rec[:, 0:2] = state.ref_positions[order]
+        rec[:, 2:4] = state.velocities[order]
+        rec[:, 4] = state.ref_times[order]
+        rec[:, 5] = discs.radii[order]
+        rec[:, 6] = discs.masses[order]
+        rec[:, 7] = state.kept_time[order]
+        self._rec = rec
+        self._count = state.collision_counts[order].astype(np.int64)
+        self._images = state.images[order].astype(np.int64)
+        partner = state.kept_partner[order]
+        self._kept_partner = np.where(partner >= 0, rank[np.maximum(partner, 0)], -1).astype(np.int64)
+        self._kept_stamp = state.kept_stamp[order].astype(np.int64)
+        self._cell = state.cell[order].astype(np.int64)
+        n_cells = len(self.grid)
+        self._head = np.full(n_cells, -1, dtype=np.int64)
+        self._tail = np.full(n_cells, -1, dtype=np.int64)
+        self._nxt = np.full(n, -1, dtype=np.int64)
+        self._prv = np.full(n, -1, dtype=np.int64)
+        members = rank[state.cell_members] if n else np.zeros(0, dtype=np.int64)
+        lp.link(members, state.cell_sizes.astype(np.int64), self._head, self._tail, self._nxt, self._prv)
+        # The queue: one slot per disc, and the heap of the discs with a pending event.
+        owners = rank[state.queue_owner] if len(state.queue_owner) else np.zeros(0, dtype=np.int64)
+        self._qt = np.full(n, np.inf)
+        self._qk = np.zeros(n, dtype=np.int64)
+        self._qo = np.zeros(n, dtype=np.int64)
+        self._qs = np.zeros(n, dtype=np.int64)
+        self._qt[owners] = state.queue_time
+        self._qk[owners] = state.queue_kind
+        collision = state.queue_kind == _COLLISION
+        self._qo[owners] = np.where(collision, rank[np.where(collision, state.queue_other, 0)], state.queue_other)
+        self._qs[owners] = state.queue_stamp
+        self._heap = np.zeros(n, dtype=np.int64)
+        self._heap[: len(owners)] = owners
+        self._hpos = np.full(n, -1, dtype=np.int64)
+        lp = self._lp
+        ints = self._ints = np.zeros(lp.N_INTS, dtype=np.int64)
+        floats = self._floats = np.zeros(lp.N_FLOATS)
+        ints[lp.I_SIZE] = len(owners)
+        lp.heapify(self._heap, self._hpos, self._qt, ints)
+        ints[lp.I_PRED] = state.predictions
+        ints[lp.I_COLL] = state.collisions
+        ints[lp.I_WALL] = state.wall_hits
+        ints[lp.I_CROSS] = state.cell_crossings
+        ints[lp.I_STALE] = state.stale
+        ints[lp.I_SINCE] = state.since_rebase
+        ints[lp.I_MAXQ] = state.max_queue
+        ints[lp.I_LKIND] = state.last_kind
+        if state.last_kind >= 0:
+            ints[lp.I_LI] = rank[state.last_i]
+            ints[lp.I_LJ] = rank[state.last_j] if state.last_j >= 0 else state.last_j
+        else:
+            ints[lp.I_LI] = ints[lp.I_LJ] = -1
+        floats[lp.F_EPOCH] = state.epoch
+        floats[lp.F_VIRIAL] = state.virial
+        floats[lp.F_OVERLAP] = state.max_overlap
+        floats[lp.F_TIME] = state.time
+        floats[lp.F_LTIME] = state.last_time
+        scene = self.scene
+        self._filtering = bool(scene.filtering)
+        self._group = scene.group[order].astype(np.int64) if self._filtering else np.zeros(n, dtype=np.int64)
+        self._blocked = np.asarray(scene.blocked, dtype=np.bool_) if self._filtering else np.zeros((1, 1), np.bool_)
+
+    def export(self) -> EventDrivenState:
+        """The run state, in the caller's numbering (new arrays)."""
+        lp, order, n = self._lp, self._order, len(self._order)
+
+        def caller(values, dtype=None) -> np.ndarray:
+            out = np.empty(np.shape(values), dtype=dtype or np.asarray(values).dtype)
+            out[order] = values
+            return out
+
+        rec, ints, floats = self._rec, self._ints, self._floats
+        members = np.zeros(n, dtype=np.int64)
+        sizes = np.zeros(len(self.grid), dtype=np.int64)
+        lp.unlink(self._head, self._nxt, members, sizes)
+        owners = np.flatnonzero(self._hpos >= 0)
+        kinds = self._qk[owners].copy()
+        others = self._qo[owners]
+        partner = self._kept_partner
+        if ints[lp.I_LKIND] < 0:
+            last = (0.0, -1, -1, -1)
+        else:
+            i, j = int(ints[lp.I_LI]), int(ints[lp.I_LJ])
+            last = (float(floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if j >= 0 else j)
+        return EventDrivenState(
+            time=float(floats[lp.F_TIME]),
+            epoch=float(floats[lp.F_EPOCH]),
+            since_rebase=int(ints[lp.I_SINCE]),
+            collisions=int(ints[lp.I_COLL]),
+            wall_hits=int(ints[lp.I_WALL]),
+            cell_crossings=int(ints[lp.I_CROSS]),
+            stale=int(ints[lp.I_STALE]),
+            predictions=int(ints[lp.I_PRED]),
+            virial=float(floats[lp.F_VIRIAL]),
+            max_overlap=float(floats[lp.F_OVERLAP]),
+            max_queue=int(ints[lp.I_MAXQ]),
+            last_time=last[0],
+            last_kind=last[1],
+            last_i=last[2],
+            last_j=last[3],
+            grid_nx=self.grid.nx,
+            grid_ny=self.grid.ny,
+            ref_positions=caller(rec[:, 0:2]),
+            velocities=caller(rec[:, 2:4]),
+            ref_times=caller(rec[:, 4]),
+            images=caller(self._images),
+            collision_counts=caller(self._count),
+            cell=caller(self._cell),
+            cell_members=order[members],
+            cell_sizes=sizes,
+            kept_time=caller(rec[:, 7]),
+            kept_partner=caller(np.where(partner >= 0, order[np.maximum(partner, 0)], -1)),
+            kept_stamp=caller(self._kept_stamp),
+            order=order.copy(),
+            queue_owner=order[owners],
+            queue_time=self._qt[owners].copy(),
+            queue_kind=kinds,
+            queue_other=np.where(kinds == _COLLISION, order[np.where(kinds == _COLLISION, others, 0)], others),
+            queue_stamp=self._qs[owners].copy(),
+        )
+
+    def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
+        """Process events with time <= ``until``; stop after ``limit`` physical events (None: no limit).
+
+        As :meth:`discsim.engines.event_driven.python.PythonBackend.advance`: also returns after
+        ``crossings`` cell crossings (None: no such limit); ``log`` receives each physical event.
+
+        Raises:
+            Interrupted: on Ctrl-C, after the event under way.
+        """
+        lp = self._lp
+        limit = -1 if limit is None else int(limit)
+        crossings = -1 if crossings is None else int(crossings)
+        recording = log is not None
+        if recording and self._events is None:
+            self._events = (
+                np.empty(LOG_ROWS),
+                np.empty(LOG_ROWS, dtype=np.int8),
+                np.empty(LOG_ROWS, dtype=np.int64),
+                np.empty(LOG_ROWS, dtype=np.int64),
+                np.empty((LOG_ROWS, 8)),
+            )
+        events = self._events if recording else _NO_EVENTS
+        args = self._loop_args()
+        done = 0
+        while True:
+            with deferred_interrupt() as interrupted:
+                while True:
+                    k, crossed, logged, why = lp.run_events(
+                        float(until),
+                        limit if limit < 0 else limit - done,
+                        crossings,
+                        BUDGET,
+                        self._rebase_every,
+                        recording,
+                        *args,
+                        *events,
+                    )
+                    done += k
+                    if logged:
+                        log.extend(_records(events, logged))
+                    if crossings >= 0:
+                        crossings -= crossed
+                    if why != lp.MORE or interrupted[0]:
+                        break
+            if not interrupted[0]:
+                return done
+
+    # --- cheap reads -----------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        return float(self._floats[self._lp.F_TIME])
+
+    @time.setter
+    def time(self, value: float) -> None:
+        self._floats[self._lp.F_TIME] = value
+
+    @property
+    def max_overlap(self) -> float:
+        return float(self._floats[self._lp.F_OVERLAP])
+
+    @max_overlap.setter
+    def max_overlap(self, value: float) -> None:
+        self._floats[self._lp.F_OVERLAP] = value
+
+    @property
+    def max_queue(self) -> int:
+        return int(self._ints[self._lp.I_MAXQ])
+
+    @property
+    def virial(self) -> float:
+        """Sum over collisions of ``dp_i . (r_i - r_j)`` since the start (for the pressure)."""
+        return float(self._floats[self._lp.F_VIRIAL])
+
+    def counts(self) -> dict[str, int]:
+        """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
+        lp, ints = self._lp, self._ints
+        return {
+            "collisions": int(ints[lp.I_COLL]),
+            "wall_hits": int(ints[lp.I_WALL]),
+            "cell_crossings": int(ints[lp.I_CROSS]),
+            "stale": int(ints[lp.I_STALE]),
+            "predictions": int(ints[lp.I_PRED]),
+        }
+
+    def positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time``, not wrapped."""
+        t = self.time - float(self._floats[self._lp.F_EPOCH])
+        rx, ry, vx, vy, tr = self._rec[self._rank, :5].T
+        return np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)]).reshape(-1, 2)
+
+    def unwrapped_positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time``, each disc followed across the periodic edges."""
+        images = self._images[self._rank].astype(np.float64)
+        return self.positions() + images * np.array([self.box.width, self.box.height])
+
+    def velocities(self) -> np.ndarray:
+        """``(N, 2)`` velocities at ``time``."""
+        return self._rec[self._rank, 2:4].copy()
+
+    def last_event(self) -> tuple[float, int, int, int] | None:
+        """``(time, kind, i, j)`` of the last physical event in the caller's numbering, or None."""
+        lp, ints = self._lp, self._ints
+        if ints[lp.I_LKIND] < 0:
+            return None
+        i, j = int(ints[lp.I_LI]), int(ints[lp.I_LJ])
+        order = self._order
+        return float(self._floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if j >= 0 else j
+
+    def queue_size(self) -> int:
+        """Events pending now (at most N)."""
+        return int(self._ints[self._lp.I_SIZE])
+
+    def queue_storage(self) -> int:
+        """Entries the queue holds: one slot per pending event (the heap holds no dead entries)."""
+        return self.queue_size()
+
+    def _check(self) -> None:
+        """Assert the backend's own invariants (heap order and positions, linked cells); O(N)."""
+        size, heap, hpos, qt = self.queue_size(), self._heap, self._hpos, self._qt
+        owners = heap[:size]
+        assert np.array_equal(hpos[owners], np.arange(size)), "heap positions out of date"
+        assert (hpos >= 0).sum() == size and np.isfinite(qt[owners]).all()
+        parents = owners[(np.arange(1, size) - 1) >> 1]
+        children = owners[1:]
+        ordered = (qt[parents] < qt[children]) | ((qt[parents] == qt[children]) & (parents < children))
+        assert ordered.all(), "heap order broken"
+        members = np.zeros(len(self._order), dtype=np.int64)
+        sizes = np.zeros(len(self.grid), dtype=np.int64)
+        self._lp.unlink(self._head, self._nxt, members, sizes)
+        assert np.array_equal(np.repeat(np.arange(len(sizes)), sizes), self._cell[members]), "cells out of date"
+
+    # --- argument lists of the compiled functions --------------------------------------------
+    def _geometry(self) -> tuple:
+        grid, box = self.grid, self.box
+        return (grid.nx, grid.ny, float(box.width), float(box.height), bool(box.periodic), self._col_lo, self._row_lo)
+
+    def _filter(self) -> tuple:
+        return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)
+
+    def _queue(self) -> tuple:
+        return (self._heap, self._hpos, self._qt, self._qk, self._qo, self._qs, self._ints)
+
+    def _predict_args(self) -> tuple:
+        return (
+            self._rec, self._count, self._kept_partner, self._kept_stamp, self._cell, self._head, self._nxt,
+            *self._geometry(), *self._filter(), *self._queue(),
+        )  # fmt: skip
+
+    def _loop_args(self) -> tuple:
+        return (
+            self._rec, self._count, self._order, self._images, self._kept_partner, self._kept_stamp,
+            self._cell, self._head, self._tail, self._nxt, self._prv,
+            *self._geometry(), *self._filter(), *self._queue(), self._floats,
+        )  # fmt: skip
+
+
+_NO_EVENTS = (
+    np.empty(0),
+    np.empty(0, dtype=np.int8),
+    np.empty(0, dtype=np.int64),
+    np.empty(0, dtype=np.int64),
+    np.empty((0, 8)),
+)
+
+
+def _records(events, k: int) -> np.ndarray:
+    """The first ``k`` rows of the loop's log buffer as an :data:`~discsim.events.EVENT_DTYPE` array."""
+    ev_t, ev_kind, ev_i, ev_j, ev_f = events
+    out = np.empty(k, dtype=EVENT_DTYPE)
+    out["time"] = ev_t[:k]
+    out["kind"] = ev_kind[:k]
+    out["i"] = ev_i[:k]
+    out["j"] = ev_j[:k]
+    for c, name in enumerate(("xi", "yi", "vxi", "vyi", "xj", "yj", "vxj", "vyj")):
+        out[name] = ev_f[:k, c]
+    return out

@@ -1,0 +1,689 @@
+"""The compiled event loop: the Python backend's algorithm, on plain arrays, compiled by numba.
+
+Imported only by :class:`~discsim.engines.event_driven.numba.backend.NumbaBackend`, and only when numba
+imports (``discsim._numba``). Every function is ``njit(cache=True)``: the first process compiles them
+(seconds) and writes machine code next to this file's ``__pycache__``; later processes load it.
+
+The algorithm, the order of the floating-point operations and the tie-breaking are those of
+:mod:`discsim.engines.event_driven.python.backend`, so both backends give the same events bit for bit;
+only the data structures differ:
+
+- ``rec`` ``(N, 8)`` float64, one 64-byte row per disc (one cache line): x, y, vx, vy, t_ref, radius,
+  mass (inf for an obstacle), and the time of the disc's kept collision;
+- cells as doubly linked lists (``head``, ``tail`` per cell; ``nxt``, ``prv`` per disc), which keep
+  each cell's members in the order they entered, as the Python backend's tuples do;
+- the queue, an indexed binary heap of owners ordered by ``(time, owner)`` with one pending event
+  per disc (``qt``, ``qk``, ``qo``, ``qs``: time, kind, other, stamp), popping in the same order as
+  the Python backend's queues;
+- counters and scalars in two small arrays, ``ints`` and ``floats`` (the ``I_*`` and ``F_*`` slots).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from discsim._numba import numba
+
+_nb = numba()
+if _nb is None:  # pragma: no cover - the backend imports this module only when numba imports
+    msg = "discsim.engines.event_driven.numba.loop needs numba"
+    raise ImportError(msg)
+
+# error_model="numpy": a division by zero gives inf or nan instead of a check on every division; the
+# loop divides only by numbers it has tested, as the Python backend does.
+jit = _nb.njit(cache=True, nogil=True, error_model="numpy")
+
+INF = math.inf
+COLLISION, WALL, CROSSING, SEGMENT = 0, 1, 2, 3
+PLUS_X, MINUS_X, PLUS_Y, MINUS_Y = 0, 1, 2, 3
+# Columns of a disc's row in ``rec``.
+X, Y, VX, VY, T, R, M, KEPT = 0, 1, 2, 3, 4, 5, 6, 7
+# Slots of ``ints``.
+I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ = range(11)
+N_INTS = 11
+# Slots of ``floats``.
+F_EPOCH, F_VIRIAL, F_OVERLAP, F_TIME, F_LTIME = range(5)
+N_FLOATS = 5
+# Why run_events returned: the queue holds nothing before ``until`` or the event limit was met; the
+# budget of pops or the log buffer ran out (call again); the crossing budget was spent.
+DONE, MORE, CROSSINGS = 0, 1, 2
+
+
+# --- the queue: an indexed binary heap of owners, ordered by (time, owner) ------------------------------
+@jit
+def _before(a, b, qt):
+    return qt[a] < qt[b] or (qt[a] == qt[b] and a < b)
+
+
+@jit
+def _sift_up(k, heap, hpos, qt):
+    owner = heap[k]
+    while k > 0:
+        parent = (k - 1) >> 1
+        p = heap[parent]
+        if _before(owner, p, qt):
+            heap[k] = p
+            hpos[p] = k
+            k = parent
+        else:
+            break
+    heap[k] = owner
+    hpos[owner] = k
+
+
+@jit
+def _sift_down(k, size, heap, hpos, qt):
+    owner = heap[k]
+    while True:
+        child = 2 * k + 1
+        if child >= size:
+            break
+        c = heap[child]
+        if child + 1 < size:
+            d = heap[child + 1]
+            if _before(d, c, qt):
+                child += 1
+                c = d
+        if _before(c, owner, qt):
+            heap[k] = c
+            hpos[c] = k
+            k = child
+        else:
+            break
+    heap[k] = owner
+    hpos[owner] = k
+
+
+@jit
+def _remove(owner, heap, hpos, qt, ints):
+    """Take ``owner``'s event out of the heap (it must be there)."""
+    k = hpos[owner]
+    hpos[owner] = -1
+    size = ints[I_SIZE] - 1
+    ints[I_SIZE] = size
+    if k == size:
+        return
+    last = heap[size]
+    heap[k] = last
+    hpos[last] = k
+    if k > 0 and _before(last, heap[(k - 1) >> 1], qt):
+        _sift_up(k, heap, hpos, qt)
+    else:
+        _sift_down(k, size, heap, hpos, qt)
+
+
+@jit
+def push(owner, t, kind, other, stamp, heap, hpos, qt, qk, qo, qs, ints):
+    """Schedule ``owner``'s event at ``t`` (finite), replacing its pending one."""
+    k = hpos[owner]
+    old = qt[owner]
+    qt[owner] = t
+    qk[owner] = kind
+    qo[owner] = other
+    qs[owner] = stamp
+    if k < 0:
+        k = ints[I_SIZE]
+        ints[I_SIZE] = k + 1
+        heap[k] = owner
+        hpos[owner] = k
+        _sift_up(k, heap, hpos, qt)
+    elif t < old:  # same owner: the key moved earlier
+        _sift_up(k, heap, hpos, qt)
+    else:
+        _sift_down(k, ints[I_SIZE], heap, hpos, qt)
+
+
+@jit
+def discard(owner, heap, hpos, qt, ints):
+    """Drop ``owner``'s pending event, if any."""
+    if hpos[owner] >= 0:
+        _remove(owner, heap, hpos, qt, ints)
+    qt[owner] = INF
+
+
+@jit
+def heapify(heap, hpos, qt, ints):
+    """Rebuild the heap from the owners it holds (after every time moved: ties may have appeared)."""
+    size = ints[I_SIZE]
+    for k in range(size):
+        hpos[heap[k]] = k
+    for k in range((size >> 1) - 1, -1, -1):
+        _sift_down(k, size, heap, hpos, qt)
+
+
+# --- geometry ------------------------------------------------------------------------------------------
+@jit
+def time_of_impact(dx, dy, dvx, dvy, sigma):
+    """As :func:`discsim.kernels.time_of_impact`."""
+    b = dx * dvx + dy * dvy
+    if b >= 0.0:
+        return INF
+    c = dx * dx + dy * dy - sigma * sigma
+    if c <= 0.0:
+        return 0.0
+    a = dvx * dvx + dvy * dvy
+    d = b * b - a * c
+    if d <= 0.0:
+        return INF
+    return c / (-b + math.sqrt(d))
+
+
+@jit
+def segment_time_of_impact(px, py, vx, vy, radius, ax, ay, bx, by):
+    """As :func:`discsim.kernels.segment_time_of_impact`."""
+    ex, ey = bx - ax, by - ay
+    length2 = ex * ex + ey * ey
+    best = INF
+    length = math.sqrt(length2)
+    nx, ny = -ey / length, ex / length
+    s = (px - ax) * nx + (py - ay) * ny
+    vn = vx * nx + vy * ny
+    if s < 0.0:
+        s, vn = -s, -vn
+    if vn < 0.0:
+        t = (s - radius) / -vn if s > radius else 0.0
+        u = ((px + vx * t - ax) * ex + (py + vy * t - ay) * ey) / length2
+        if 0.0 <= u <= 1.0:
+            best = t
+    t = time_of_impact(ax - px, ay - py, -vx, -vy, radius)
+    if t < best:
+        best = t
+    t = time_of_impact(bx - px, by - py, -vx, -vy, radius)
+    if t < best:
+        best = t
+    return best
+
+
+@jit
+def reflect_off_segment(px, py, vx, vy, ax, ay, bx, by):
+    """As :func:`discsim.kernels.reflect_off_segment`."""
+    ex, ey = bx - ax, by - ay
+    u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
+    u = min(max(u, 0.0), 1.0)
+    qx, qy = ax + u * ex, ay + u * ey
+    nx, ny = px - qx, py - qy
+    k = 2.0 * (vx * nx + vy * ny) / (nx * nx + ny * ny)
+    return vx - k * nx, vy - k * ny
+
+
+# --- prediction ----------------------------------------------------------------------------------------
+@jit
+def predict(
+    i, t, exclude, direction,
+    rec, count, kept_partner, kept_stamp, cell, head, nxt,
+    nx, ny, width, height, periodic, col_lo, row_lo,
+    seg, seg_start, seg_idx, filtering, group, blocked,
+    heap, hpos, qt, qk, qo, qs, ints,
+):  # fmt: skip
+    """Schedule disc ``i``'s earliest event after ``t``, as the Python backend's ``predict`` does.
+
+    Its collision with a disc in the 3x3 cells around it (never ``exclude``; after a crossing in
+    ``direction`` only the 3 cells that just became adjacent, with the kept collision standing for
+    the other 6 while its partner has not changed course), its wall or segment hit, or its cell
+    crossing; the earliest collision found is kept per disc.
+    """
+    ints[I_PRED] += 1
+    xi = rec[i, X]
+    yi = rec[i, Y]
+    vxi = rec[i, VX]
+    vyi = rec[i, VY]
+    ri = rec[i, R]
+    dti = t - rec[i, T]
+    xi += vxi * dti
+    yi += vyi * dti
+    c = cell[i]
+    cx = c // ny
+    cy = c - cx * ny
+    # 1. The earliest collision with a neighbour.
+    partner = kept_partner[i]
+    after_crossing = direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i])
+    best = INF
+    new_partner = -1
+    gi = group[i] if filtering else 0
+    for ddx in range(-1, 2):
+        if after_crossing and ((direction == PLUS_X and ddx != 1) or (direction == MINUS_X and ddx != -1)):
+            continue
+        ox = cx + ddx
+        sx = 0.0
+        if periodic:
+            if ox < 0:
+                ox += nx
+                sx = -width
+            elif ox >= nx:
+                ox -= nx
+                sx = width
+        elif ox < 0 or ox >= nx:
+            continue
+        for ddy in range(-1, 2):
+            if after_crossing and ((direction == PLUS_Y and ddy != 1) or (direction == MINUS_Y and ddy != -1)):
+                continue
+            oy = cy + ddy
+            sy = 0.0
+            if periodic:
+                if oy < 0:
+                    oy += ny
+                    sy = -height
+                elif oy >= ny:
+                    oy -= ny
+                    sy = height
+            elif oy < 0 or oy >= ny:
+                continue
+            j = head[ox * ny + oy]
+            if j < 0:
+                continue
+            offx = sx - xi
+            offy = sy - yi
+            while j >= 0:
+                if j == i or j == exclude or (filtering and blocked[gi, group[j]]):
+                    j = nxt[j]
+                    continue
+                vxj = rec[j, VX]
+                vyj = rec[j, VY]
+                dvx = vxj - vxi
+                dvy = vyj - vyi
+                dtj = t - rec[j, T]
+                dx = rec[j, X] + vxj * dtj + offx
+                dy = rec[j, Y] + vyj * dtj + offy
+                b = dx * dvx + dy * dvy
+                if b < 0.0:
+                    s = ri + rec[j, R]
+                    cc = dx * dx + dy * dy - s * s
+                    if cc <= 0.0:
+                        tij = 0.0
+                    else:
+                        a = dvx * dvx + dvy * dvy
+                        d = b * b - a * cc
+                        tij = cc / (-b + math.sqrt(d)) if d > 0.0 else INF
+                    if tij < best:
+                        best = tij
+                        new_partner = j
+                j = nxt[j]
+    if after_crossing:
+        t_hit = rec[i, KEPT]
+        if t + best < t_hit:
+            t_hit = t + best
+            partner = new_partner
+            rec[i, KEPT] = t_hit
+            kept_partner[i] = partner
+            kept_stamp[i] = count[partner]
+    else:
+        t_hit = t + best
+        partner = new_partner
+        rec[i, KEPT] = t_hit
+        kept_partner[i] = partner
+        if partner >= 0:
+            kept_stamp[i] = count[partner]
+    # 2. The next wall, segment or cell boundary.
+    best = INF
+    kind = CROSSING
+    other = 0
+    if vxi > 0.0:
+        if not periodic and cx == nx - 1:
+            best = (width - ri - xi) / vxi
+            kind = WALL
+        else:
+            best = (col_lo[cx + 1] - xi) / vxi
+            other = PLUS_X
+    elif vxi < 0.0:
+        if not periodic and cx == 0:
+            best = (ri - xi) / vxi
+            kind = WALL
+        else:
+            best = (col_lo[cx] - xi) / vxi
+            other = MINUS_X
+    if vyi > 0.0:
+        if not periodic and cy == ny - 1:
+            ty = (height - ri - yi) / vyi
+            if ty < best:
+                best, kind, other = ty, WALL, 1
+        else:
+            ty = (row_lo[cy + 1] - yi) / vyi
+            if ty < best:
+                best, kind, other = ty, CROSSING, PLUS_Y
+    elif vyi < 0.0:
+        if not periodic and cy == 0:
+            ty = (ri - yi) / vyi
+            if ty < best:
+                best, kind, other = ty, WALL, 1
+        else:
+            ty = (row_lo[cy] - yi) / vyi
+            if ty < best:
+                best, kind, other = ty, CROSSING, MINUS_Y
+    for m in range(seg_start[c], seg_start[c + 1]):
+        k = seg_idx[m]
+        if k != -2 - exclude:  # not the segment just left
+            ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3])
+            if ts < best:
+                best, kind, other = ts, SEGMENT, k
+    if best < 0.0:
+        best = 0.0
+    # 3. Schedule the earlier of the two.
+    t_best = t + best
+    if t_hit <= t_best and partner >= 0:
+        push(i, t_hit, COLLISION, partner, count[partner], heap, hpos, qt, qk, qo, qs, ints)
+    elif best == INF:
+        discard(i, heap, hpos, qt, ints)
+    else:
+        push(i, t_best, kind, other, 0, heap, hpos, qt, qk, qo, qs, ints)
+
+
+@jit
+def predict_all(
+    rec, count, kept_partner, kept_stamp, cell, head, nxt,
+    nx, ny, width, height, periodic, col_lo, row_lo,
+    seg, seg_start, seg_idx, filtering, group, blocked,
+    heap, hpos, qt, qk, qo, qs, ints,
+):  # fmt: skip
+    """The start of a run: predict every moving disc at time 0, in internal order."""
+    for i in range(rec.shape[0]):
+        if rec[i, M] != INF:
+            predict(
+                i, 0.0, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                nx, ny, width, height, periodic, col_lo, row_lo,
+                seg, seg_start, seg_idx, filtering, group, blocked,
+                heap, hpos, qt, qk, qo, qs, ints,
+            )  # fmt: skip
+    ints[I_MAXQ] = ints[I_SIZE]
+
+
+# --- cells ---------------------------------------------------------------------------------------------
+@jit
+def link(members, sizes, head, tail, nxt, prv):
+    """Build the cells' linked lists from ``members`` (internal numbers, cell by cell) and ``sizes``."""
+    k = 0
+    for c in range(sizes.shape[0]):
+        previous = -1
+        head[c] = -1
+        for _ in range(sizes[c]):
+            j = members[k]
+            k += 1
+            prv[j] = previous
+            nxt[j] = -1
+            if previous < 0:
+                head[c] = j
+            else:
+                nxt[previous] = j
+            previous = j
+        tail[c] = previous
+
+
+@jit
+def unlink(head, nxt, members, sizes):
+    """The cells' members in order (internal numbers), cell by cell, and each cell's size."""
+    k = 0
+    for c in range(head.shape[0]):
+        j = head[c]
+        n = 0
+        while j >= 0:
+            members[k] = j
+            k += 1
+            n += 1
+            j = nxt[j]
+        sizes[c] = n
+
+
+@jit
+def _leave(i, c, head, tail, nxt, prv):
+    p, q = prv[i], nxt[i]
+    if p < 0:
+        head[c] = q
+    else:
+        nxt[p] = q
+    if q < 0:
+        tail[c] = p
+    else:
+        prv[q] = p
+
+
+@jit
+def _enter(i, c, head, tail, nxt, prv):
+    last = tail[c]
+    prv[i] = last
+    nxt[i] = -1
+    if last < 0:
+        head[c] = i
+    else:
+        nxt[last] = i
+    tail[c] = i
+
+
+# --- the hot loop --------------------------------------------------------------------------------------
+@jit
+def rebase(shift, rec, heap, hpos, qt, ints, floats):
+    """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``."""
+    for i in range(rec.shape[0]):
+        rec[i, T] -= shift
+        rec[i, KEPT] = rec[i, KEPT] - shift
+        qt[i] = qt[i] - shift
+    heapify(heap, hpos, qt, ints)
+    floats[F_EPOCH] += shift
+
+
+@jit
+def run_events(
+    until, limit, crossings, budget, rebase_every, recording,
+    rec, count, order, images, kept_partner, kept_stamp, cell, head, tail, nxt, prv,
+    nx, ny, width, height, periodic, col_lo, row_lo,
+    seg, seg_start, seg_idx, filtering, group, blocked,
+    heap, hpos, qt, qk, qo, qs, ints, floats,
+    ev_t, ev_kind, ev_i, ev_j, ev_f,
+):  # fmt: skip
+    """Process events with times <= ``until``: the Python backend's ``_process_events``, compiled.
+
+    Stops after ``limit`` physical events (-1: no limit), ``crossings`` cell crossings (-1: none),
+    ``budget`` pops, or when the log buffer (``ev_*``, written when ``recording``) is full.
+
+    Returns:
+        ``(done, crossed, logged, why)``: physical events, crossings, records written, and
+        why it stopped (``DONE``, ``MORE`` or ``CROSSINGS``).
+    """
+    n_coll = n_wall = n_cross = n_stale = 0
+    done = 0
+    logged = 0
+    capacity = ev_t.shape[0]
+    pops = 0
+    why = DONE
+    max_queue = ints[I_MAXQ]
+    virial = floats[F_VIRIAL]
+    max_overlap = floats[F_OVERLAP]
+    epoch = floats[F_EPOCH]
+    horizon = until - epoch
+    rebase_at = rebase_every - ints[I_SINCE]
+    now = np.nan
+    have_now = False
+    last_time, last_kind, last_i, last_j = floats[F_LTIME], ints[I_LKIND], ints[I_LI], ints[I_LJ]
+    while done != limit:
+        if pops == budget or (recording and logged == capacity):
+            why = MORE
+            break
+        # Pop the earliest event if it is due.
+        if ints[I_SIZE] == 0:
+            break
+        i = heap[0]
+        t = qt[i]
+        if t > horizon:
+            break
+        pops += 1
+        _remove(i, heap, hpos, qt, ints)
+        qt[i] = INF
+        kind = qk[i]
+        other = qo[i]
+        if kind == COLLISION:
+            j = other
+            if count[j] != qs[i]:  # the partner has changed course since the prediction
+                n_stale += 1
+                predict(
+                    i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                    nx, ny, width, height, periodic, col_lo, row_lo,
+                    seg, seg_start, seg_idx, filtering, group, blocked,
+                    heap, hpos, qt, qk, qo, qs, ints,
+                )  # fmt: skip
+                continue
+            vxi = rec[i, VX]
+            vyi = rec[i, VY]
+            ri = rec[i, R]
+            dt = t - rec[i, T]
+            xi = rec[i, X] + vxi * dt
+            yi = rec[i, Y] + vyi * dt
+            vxj = rec[j, VX]
+            vyj = rec[j, VY]
+            rj = rec[j, R]
+            dt = t - rec[j, T]
+            xj = rec[j, X] + vxj * dt
+            yj = rec[j, Y] + vyj * dt
+            dx, dy = xj - xi, yj - yi
+            if periodic:
+                dx -= width * np.rint(dx / width)
+                dy -= height * np.rint(dy / height)
+            overlap = 1.0 - math.sqrt(dx * dx + dy * dy) / (ri + rj)
+            if overlap > max_overlap:
+                max_overlap = overlap
+            mi, mj = rec[i, M], rec[j, M]
+            # The elastic response, as discsim.kernels.resolve_collision.
+            d2 = dx * dx + dy * dy
+            bb = (vxj - vxi) * dx + (vyj - vyi) * dy
+            if mi == INF:
+                f1, f2 = 0.0, 2.0
+            elif mj == INF:
+                f1, f2 = 2.0, 0.0
+            else:
+                f1, f2 = 2.0 * mj / (mi + mj), 2.0 * mi / (mi + mj)
+            k = bb / d2
+            uxi = vxi + f1 * k * dx
+            uyi = vyi + f1 * k * dy
+            uxj = vxj - f2 * k * dx
+            uyj = vyj - f2 * k * dy
+            rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, uxi, uyi, t
+            rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], rec[j, T] = xj, yj, uxj, uyj, t
+            virial -= mi * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
+            count[i] += 1
+            n_coll += 1
+            done += 1
+            if recording:
+                ev_t[logged] = t + epoch
+                ev_kind[logged] = COLLISION
+                ev_i[logged] = order[i]
+                ev_j[logged] = order[j]
+                ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, uxi, uyi
+                ev_f[logged, 4], ev_f[logged, 5], ev_f[logged, 6], ev_f[logged, 7] = xj, yj, uxj, uyj
+                logged += 1
+            predict(
+                i, t, j, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                nx, ny, width, height, periodic, col_lo, row_lo,
+                seg, seg_start, seg_idx, filtering, group, blocked,
+                heap, hpos, qt, qk, qo, qs, ints,
+            )  # fmt: skip
+            if mj != INF:  # obstacles never move, and their counter never changes
+                count[j] += 1
+                predict(
+                    j, t, i, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                    nx, ny, width, height, periodic, col_lo, row_lo,
+                    seg, seg_start, seg_idx, filtering, group, blocked,
+                    heap, hpos, qt, qk, qo, qs, ints,
+                )  # fmt: skip
+                if ints[I_SIZE] > max_queue:
+                    max_queue = ints[I_SIZE]
+            last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j
+        elif kind == WALL or kind == SEGMENT:
+            vxi = rec[i, VX]
+            vyi = rec[i, VY]
+            dt = t - rec[i, T]
+            xi = rec[i, X] + vxi * dt
+            yi = rec[i, Y] + vyi * dt
+            if kind == SEGMENT:
+                vxi, vyi = reflect_off_segment(
+                    xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
+                )
+                exclude = -2 - other  # never the same segment again straight away
+            else:
+                if other == 0:
+                    vxi = -vxi
+                else:
+                    vyi = -vyi
+                exclude = -1
+            rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, vxi, vyi, t
+            count[i] += 1
+            n_wall += 1
+            done += 1
+            if recording:
+                ev_t[logged] = t + epoch
+                ev_kind[logged] = WALL
+                ev_i[logged] = order[i]
+                ev_j[logged] = -1
+                ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, vxi, vyi
+                ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
+                logged += 1
+            predict(
+                i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                nx, ny, width, height, periodic, col_lo, row_lo,
+                seg, seg_start, seg_idx, filtering, group, blocked,
+                heap, hpos, qt, qk, qo, qs, ints,
+            )  # fmt: skip
+            last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
+        else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
+            c = cell[i]
+            _leave(i, c, head, tail, nxt, prv)
+            cx = c // ny
+            cy = c - cx * ny
+            if other == PLUS_X:
+                cx += 1
+                if cx == nx:
+                    cx = 0
+                    rec[i, X] = rec[i, X] - width
+                    images[i, 0] += 1
+            elif other == MINUS_X:
+                cx -= 1
+                if cx < 0:
+                    cx = nx - 1
+                    rec[i, X] = rec[i, X] + width
+                    images[i, 0] -= 1
+            elif other == PLUS_Y:
+                cy += 1
+                if cy == ny:
+                    cy = 0
+                    rec[i, Y] = rec[i, Y] - height
+                    images[i, 1] += 1
+            else:
+                cy -= 1
+                if cy < 0:
+                    cy = ny - 1
+                    rec[i, Y] = rec[i, Y] + height
+                    images[i, 1] -= 1
+            c = cx * ny + cy
+            cell[i] = c
+            _enter(i, c, head, tail, nxt, prv)
+            n_cross += 1
+            predict(
+                i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                nx, ny, width, height, periodic, col_lo, row_lo,
+                seg, seg_start, seg_idx, filtering, group, blocked,
+                heap, hpos, qt, qk, qo, qs, ints,
+            )  # fmt: skip
+            if n_cross == crossings:
+                now = t
+                have_now = True
+                why = CROSSINGS
+                break
+        now = t
+        have_now = True
+        if done >= rebase_at:
+            rebase(now, rec, heap, hpos, qt, ints, floats)
+            epoch = floats[F_EPOCH]
+            now = 0.0
+            horizon = until - epoch
+            rebase_at = done + rebase_every
+    ints[I_SINCE] = rebase_every - (rebase_at - done)
+    ints[I_MAXQ] = max_queue
+    floats[F_VIRIAL] = virial
+    floats[F_OVERLAP] = max_overlap
+    if have_now:
+        floats[F_TIME] = now + epoch
+    floats[F_LTIME] = last_time
+    ints[I_LKIND], ints[I_LI], ints[I_LJ] = last_kind, last_i, last_j
+    ints[I_COLL] += n_coll
+    ints[I_WALL] += n_wall
+    ints[I_CROSS] += n_cross
+    ints[I_STALE] += n_stale
+    return done, n_cross, logged, why

@@ -37,6 +37,7 @@ from discsim.io.streams import StreamedEvents, read_events, trajectory_from_even
 from discsim.model import Box, Discs, Segment, polygon
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
+from discsim.view import View, view  # cheap (no matplotlib); binds ds.view to the function, not the module
 
 __version__ = "0.1.0"
 
@@ -81,6 +82,7 @@ __all__ = [
     "Segment",
     "StreamedEvents",
     "TimeError",
+    "View",
     "billiard_break",
     "checkpoint_info",
     "compare",
@@ -99,4 +101,5 @@ __all__ = [
     "speed_pdf",
     "study_cases",
     "trajectory_from_events",
+    "view",
 ]

@@ -13,7 +13,7 @@ FLOORS = {
     "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt"],
     "model": ["scene", "scenarios", "events", "trajectory", "cells"],
     "engines": ["engines"],
-    "top": ["run", "io", "analysis", "cli", "plot", "__init__", "__main__"],
+    "top": ["run", "io", "analysis", "cli", "plot", "view", "__init__", "__main__"],
 }
 LEVEL = {name: level for level, names in enumerate(FLOORS.values()) for name in names}
 

@@ -1,0 +1,416 @@
+// discsim viewer: replays runs exactly from their event logs (inlined into every view.html by discsim/view.py).
+//
+// Each disc has a list of state records (time, x, y, vx, vy): where the replay starts, then after each of its
+// events. Between records a disc flies straight, so its position at time t is that of its last record at or
+// before t plus velocity times the time since, wrapped into a periodic box: the same operations, in the same
+// order, as discsim.trajectory.reconstruct, so the page draws the numbers trajectory() gives.
+"use strict";
+(function () {
+  const DATA = JSON.parse(document.getElementById("ds-data").textContent);
+  const TAB10 = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                 "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+  const OBSTACLE = "#8c8c8c";
+  // viridis at 9 evenly spaced points, interpolated linearly
+  const VIRIDIS = [[68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
+                   [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37]];
+
+  function decode(b64, Type) {
+    const bin = atob(b64);
+    const bytes = new Uint8Array(bin.length);
+    for (let k = 0; k < bin.length; k++) bytes[k] = bin.charCodeAt(k);
+    return new Type(bytes.buffer);
+  }
+
+  // numpy's mod for a positive divisor, then Box.wrap's rule: a result equal to the size becomes 0.
+  function wrap(x, size) {
+    let m = x % size;
+    if (m !== 0 && m < 0) m += size;
+    return m >= size ? 0 : m;
+  }
+
+  function viridis(f) {
+    f = Math.min(1, Math.max(0, f)) * (VIRIDIS.length - 1);
+    const k = Math.min(VIRIDIS.length - 2, Math.floor(f));
+    const u = f - k;
+    const c = VIRIDIS[k].map((a, m) => Math.round(a + (VIRIDIS[k + 1][m] - a) * u));
+    return `rgb(${c[0]},${c[1]},${c[2]})`;
+  }
+
+  // --- the runs ----------------------------------------------------------------------------------------------
+  const runs = DATA.runs.map((r) => {
+    const run = {
+      label: r.label, engine: r.engine, dt: r.dt, truth: r.truth, n: r.n, box: r.box, segments: r.segments,
+      radii: decode(r.radii, Float64Array), fixed: decode(r.fixed, Uint8Array),
+      groups: decode(r.groups, Int32Array), starts: decode(r.starts, Int32Array),
+      times: decode(r.times, Float64Array), states: decode(r.states, Float64Array),
+      partners: decode(r.partners, Int32Array), maxSpeed: r.max_speed,
+      contactTimes: decode(r.contact_times, Float64Array), contactPairs: decode(r.contact_pairs, Int32Array),
+    };
+    run.x = new Float64Array(run.n);
+    run.y = new Float64Array(run.n);
+    run.rec = new Int32Array(run.n);
+    run.drawnTime = NaN;
+    return run;
+  });
+  const T0 = DATA.span[0], T1 = DATA.span[1];
+
+  // The last record of disc d at or before t (as numpy's searchsorted(..., side="right") - 1, at least the first).
+  function recordAt(run, d, t) {
+    let lo = run.starts[d], hi = run.starts[d + 1];
+    const first = lo;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (run.times[mid] <= t) lo = mid + 1; else hi = mid;
+    }
+    return Math.max(first, lo - 1);
+  }
+
+  // Every disc's position at time t into run.x, run.y (and its record into run.rec).
+  function evaluate(run, t) {
+    const s = run.states, w = run.box.width, h = run.box.height, periodic = run.box.periodic;
+    for (let d = 0; d < run.n; d++) {
+      const k = recordAt(run, d, t);
+      const dt = t - run.times[k];
+      let x = s[4 * k] + s[4 * k + 2] * dt;
+      let y = s[4 * k + 1] + s[4 * k + 3] * dt;
+      if (periodic) { x = wrap(x, w); y = wrap(y, h); }
+      run.x[d] = x; run.y[d] = y; run.rec[d] = k;
+    }
+  }
+
+  function positionOf(run, d, t) {
+    const k = recordAt(run, d, t), s = run.states, dt = t - run.times[k];
+    let x = s[4 * k] + s[4 * k + 2] * dt, y = s[4 * k + 1] + s[4 * k + 3] * dt;
+    if (run.box.periodic) { x = wrap(x, run.box.width); y = wrap(y, run.box.height); }
+    return [x, y];
+  }
+
+  // Exact contacts of the truth runs: time, both discs and where they touched.
+  const contacts = [];
+  for (const run of runs) {
+    if (!run.truth) continue;
+    for (let c = 0; c < run.contactTimes.length; c++) {
+      const t = run.contactTimes[c];
+      for (const d of [run.contactPairs[2 * c], run.contactPairs[2 * c + 1]]) {
+        const [x, y] = positionOf(run, d, t);
+        contacts.push({ t, d, x, y, r: run.radii[d], fixed: run.fixed[d], group: run.groups[d] });
+      }
+    }
+  }
+  contacts.sort((a, b) => a.t - b.t);
+
+  // Every event time of every run, sorted, for stepping event by event.
+  const eventTimes = (() => {
+    const all = [];
+    for (const run of runs) for (let k = 0; k < run.times.length; k++) if (run.partners[k] !== -2) all.push(run.times[k]);
+    all.sort((a, b) => a - b);
+    return all.filter((t, k) => (k === 0 || t !== all[k - 1]) && t >= T0 && t <= T1);
+  })();
+  const frameStep = Math.max(0, ...runs.map((r) => r.dt || 0));
+
+  // --- state of the player -----------------------------------------------------------------------------------
+  const state = {
+    t: T0, playing: false, speed: DATA.speed, fps: DATA.fps, colour: DATA.colour,
+    contacts: true, numbers: runs[0].n <= 20, loop: false, timer: null, wallStart: 0, tStart: T0,
+  };
+
+  function colourOf(run, d) {
+    if (run.fixed[d]) return OBSTACLE;
+    if (state.colour === "group") return TAB10[((run.groups[d] % 10) + 10) % 10];
+    if (state.colour === "speed") {
+      const k = run.rec[d], s = run.states;
+      return viridis(run.maxSpeed > 0 ? Math.hypot(s[4 * k + 2], s[4 * k + 3]) / run.maxSpeed : 0);
+    }
+    return TAB10[d % 10];
+  }
+
+  function contactColour(c) {
+    if (c.fixed) return OBSTACLE;
+    if (state.colour === "group") return TAB10[((c.group % 10) + 10) % 10];
+    if (state.colour === "speed") return "#222";
+    return TAB10[c.d % 10];
+  }
+
+  // --- the page ------------------------------------------------------------------------------------------------
+  const panelsEl = document.getElementById("ds-panels");
+  const panels = runs.map((run) => {
+    const div = document.createElement("div");
+    div.className = "ds-panel";
+    const h2 = document.createElement("h2");
+    h2.textContent = run.label;
+    const canvas = document.createElement("canvas");
+    div.append(h2, canvas);
+    panelsEl.append(div);
+    return { run, canvas, ctx: canvas.getContext("2d"), scale: 1, pad: 0, cssWidth: 0, cssHeight: 0 };
+  });
+
+  function layout() {
+    const ratio = window.devicePixelRatio || 1;
+    for (const p of panels) {
+      const box = p.run.box;
+      const cssWidth = Math.max(120, p.canvas.parentElement.clientWidth - 2);
+      const maxHeight = Math.max(160, window.innerHeight * 0.72);
+      const pad = 0.02 * Math.max(box.width, box.height);
+      const scale = Math.min(cssWidth / (box.width + 2 * pad), maxHeight / (box.height + 2 * pad));
+      p.scale = scale; p.pad = pad;
+      p.cssWidth = cssWidth;
+      p.cssHeight = Math.ceil((box.height + 2 * pad) * scale);
+      p.canvas.style.height = p.cssHeight + "px";
+      p.canvas.width = Math.round(cssWidth * ratio);
+      p.canvas.height = Math.round(p.cssHeight * ratio);
+      p.ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+    }
+  }
+
+  function draw(p, t) {
+    const { run, ctx, scale } = p;
+    const box = run.box, pad = p.pad;
+    const ox = (p.cssWidth - (box.width + 2 * pad) * scale) / 2;
+    const X = (x) => ox + (x + pad) * scale;
+    const Y = (y) => p.cssHeight - (y + pad) * scale;
+    ctx.clearRect(0, 0, p.cssWidth, p.cssHeight);
+    ctx.save();
+    ctx.beginPath();
+    ctx.rect(X(0), Y(box.height), box.width * scale, box.height * scale);
+    if (box.periodic) ctx.clip();  // discs crossing a periodic edge show on both sides
+    const shifts = box.periodic ? [-1, 0, 1] : [0];
+    for (let d = 0; d < run.n; d++) {
+      const r = run.radii[d];
+      ctx.fillStyle = colourOf(run, d);
+      ctx.globalAlpha = 0.8;
+      for (const sx of shifts) {
+        for (const sy of shifts) {
+          const x = run.x[d] + sx * box.width, y = run.y[d] + sy * box.height;
+          if (x + r < 0 || x - r > box.width || y + r < 0 || y - r > box.height) continue;
+          ctx.beginPath();
+          ctx.arc(X(x), Y(y), Math.max(0.5, r * scale), 0, 2 * Math.PI);
+          ctx.fill();
+        }
+      }
+    }
+    ctx.globalAlpha = 1;
+    if (state.contacts && contacts.length) {
+      const window_ = DATA.contact_window;
+      ctx.lineWidth = 1.8;
+      ctx.setLineDash(run.truth ? [] : [5, 4]);
+      for (const c of contacts) {
+        if (c.t > t) break;
+        if (window_ !== null && c.t < t - window_) continue;
+        ctx.strokeStyle = contactColour(c);
+        ctx.beginPath();
+        ctx.arc(X(c.x), Y(c.y), Math.max(0.5, c.r * scale), 0, 2 * Math.PI);
+        ctx.stroke();
+      }
+      ctx.setLineDash([]);
+    }
+    if (state.numbers && run.n <= 50) {
+      ctx.fillStyle = "#111";
+      ctx.textAlign = "center";
+      ctx.textBaseline = "middle";
+      for (let d = 0; d < run.n; d++) {
+        const size = Math.max(9, Math.min(14, run.radii[d] * scale * 0.9));
+        ctx.font = `${size}px sans-serif`;
+        ctx.fillText(String(d), X(run.x[d]), Y(run.y[d]));
+      }
+    }
+    ctx.restore();
+    ctx.strokeStyle = "#333";
+    ctx.lineWidth = 1.2;
+    ctx.setLineDash(box.periodic ? [2, 3] : []);
+    ctx.strokeRect(X(0), Y(box.height), box.width * scale, box.height * scale);
+    ctx.setLineDash([]);
+    ctx.lineWidth = 2;
+    for (const s of run.segments) {
+      ctx.beginPath();
+      ctx.moveTo(X(s[0]), Y(s[1]));
+      ctx.lineTo(X(s[2]), Y(s[3]));
+      ctx.stroke();
+    }
+    ctx.fillStyle = "rgba(255,255,255,0.8)";
+    ctx.fillRect(X(0) + 2, Y(box.height) + 2, 92, 17);
+    ctx.fillStyle = "#111";
+    ctx.font = "12px sans-serif";
+    ctx.textAlign = "left";
+    ctx.textBaseline = "top";
+    ctx.fillText(`t = ${t.toFixed(4)}`, X(0) + 5, Y(box.height) + 4);
+  }
+
+  // --- controls ------------------------------------------------------------------------------------------------
+  const controls = document.getElementById("ds-controls");
+  function el(tag, props, parent = controls) {
+    const e = Object.assign(document.createElement(tag), props);
+    parent.append(e);
+    return e;
+  }
+  function labelled(text, input) {
+    const label = el("label", { textContent: text + " " });
+    label.append(input);
+    return input;
+  }
+  el("button", { textContent: "|<", title: "to the start (Home)", onclick: () => seek(T0) });
+  el("button", { textContent: "<<", title: "previous event (Shift+Left)", onclick: () => previousEvent() });
+  el("button", { textContent: "<", title: "one frame back (Left)", onclick: () => step(-1) });
+  const playButton = el("button", { textContent: "Play", title: "play / pause (Space)", onclick: () => toggle() });
+  el("button", { textContent: ">", title: "one frame on (Right)", onclick: () => step(1) });
+  el("button", { textContent: ">>", title: "next event (Shift+Right)", onclick: () => nextEvent() });
+  el("button", { textContent: ">|", title: "to the end (End)", onclick: () => seek(T1) });
+  const SCRUB = 100000;
+  const scrub = el("input", { type: "range", id: "ds-scrub", min: 0, max: SCRUB, step: 1, value: 0 });
+  scrub.oninput = () => seek(T0 + (T1 - T0) * (scrub.value / SCRUB));
+  const timeEl = el("span", { id: "ds-time" });
+  const timeInput = labelled("go to t =", el("input", { type: "number", step: "any", value: T0 }));
+  timeInput.onchange = () => seek(Number(timeInput.value));
+  const speedInput = labelled("speed (time/s)", el("input", { type: "number", step: "any", min: 0, value: state.speed }));
+  speedInput.onchange = () => setSpeed(Number(speedInput.value));
+  const fpsInput = labelled("fps", el("input", { type: "number", step: "any", min: 1, value: state.fps }));
+  fpsInput.onchange = () => setFps(Number(fpsInput.value));
+  const colourSelect = labelled("colour", el("select", {}));
+  for (const mode of ["disc", "group", "speed"]) el("option", { value: mode, textContent: mode }, colourSelect);
+  colourSelect.value = state.colour;
+  colourSelect.onchange = () => setColour(colourSelect.value);
+  const scaleEl = el("span", { id: "ds-scale", title: "speed: 0 (left) to the 99th percentile of the replay (right)" });
+  scaleEl.style.background = `linear-gradient(to right, ${[0, 0.25, 0.5, 0.75, 1].map(viridis).join(",")})`;
+  const contactsBox = labelled("contacts", el("input", { type: "checkbox", checked: state.contacts }));
+  contactsBox.onchange = () => { state.contacts = contactsBox.checked; render(); };
+  const numbersBox = labelled("numbers", el("input", { type: "checkbox", checked: state.numbers }));
+  numbersBox.onchange = () => { state.numbers = numbersBox.checked; render(); };
+  const loopBox = labelled("loop", el("input", { type: "checkbox", checked: state.loop }));
+  loopBox.onchange = () => { state.loop = loopBox.checked; };
+
+  document.getElementById("ds-info").textContent =
+    `${runs[0].n} discs, ${runs[0].box.periodic ? "periodic box" : "box with walls"} ` +
+    `${+runs[0].box.width.toPrecision(6)} x ${+runs[0].box.height.toPrecision(6)}; t from ${T0} to ${T1}; ` +
+    `${eventTimes.length} event times; ${contacts.length / 2} exact contacts (outlined). ` +
+    "Keys: Space play/pause, Left/Right one frame, Shift+Left/Right one event.";
+
+  // --- the player ----------------------------------------------------------------------------------------------
+  function render() {
+    for (const p of panels) {
+      evaluate(p.run, state.t);
+      p.run.drawnTime = state.t;
+      draw(p, state.t);
+    }
+    timeEl.textContent = `t = ${state.t.toPrecision(8)} of [${T0}, ${T1}]`;
+    if (document.activeElement !== scrub) scrub.value = T1 > T0 ? Math.round(((state.t - T0) / (T1 - T0)) * SCRUB) : 0;
+    colourSelect.value = state.colour;
+    scaleEl.style.display = state.colour === "speed" ? "inline-block" : "none";
+  }
+
+  function seek(t) {
+    if (!Number.isFinite(t)) return state.t;
+    state.t = Math.min(T1, Math.max(T0, t));
+    if (state.playing) { state.tStart = state.t; state.wallStart = performance.now(); }
+    render();
+    return state.t;
+  }
+
+  function tick() {
+    if (!state.playing) return;
+    let t = state.tStart + ((performance.now() - state.wallStart) / 1000) * state.speed;
+    if (t >= T1) {
+      if (state.loop) { state.tStart = T0; state.wallStart = performance.now(); t = T0; } else { t = T1; }
+    }
+    state.t = t;
+    render();
+    if (t >= T1 && !state.loop) { pause(); return; }
+    state.timer = setTimeout(tick, 1000 / state.fps);
+  }
+
+  function play() {
+    if (state.playing) return;
+    if (state.t >= T1) state.t = T0;
+    state.playing = true;
+    state.tStart = state.t;
+    state.wallStart = performance.now();
+    playButton.textContent = "Pause";
+    state.timer = setTimeout(tick, 1000 / state.fps);
+  }
+
+  function pause() {
+    state.playing = false;
+    clearTimeout(state.timer);
+    playButton.textContent = "Play";
+  }
+
+  function toggle() { if (state.playing) pause(); else play(); }
+
+  // One frame: a PIT run's frame interval (to the next frame time), else what one drawn frame covers while playing.
+  function step(frames = 1) {
+    pause();
+    if (frameStep > 0) {
+      const x = (state.t - T0) / frameStep;
+      const k = Math.abs(x - Math.round(x)) < 1e-9 ? Math.round(x) : frames > 0 ? Math.floor(x) : Math.ceil(x);
+      return seek(T0 + (k + frames) * frameStep);
+    }
+    return seek(state.t + (frames * state.speed) / state.fps);
+  }
+
+  function nextEvent() {
+    pause();
+    const t = eventTimes.find((e) => e > state.t);
+    return seek(t === undefined ? T1 : t);
+  }
+
+  function previousEvent() {
+    pause();
+    let t = T0;
+    for (const e of eventTimes) { if (e < state.t) t = e; else break; }
+    return seek(t);
+  }
+
+  function setSpeed(s) {
+    if (!(s > 0) || !Number.isFinite(s)) return state.speed;
+    state.speed = s;
+    speedInput.value = s;
+    if (state.playing) { state.tStart = state.t; state.wallStart = performance.now(); }
+    return s;
+  }
+
+  function setFps(f) {
+    if (!(f > 0) || !Number.isFinite(f)) return state.fps;
+    state.fps = f;
+    fpsInput.value = f;
+    return f;
+  }
+
+  function setColour(mode) {
+    if (["disc", "group", "speed"].includes(mode)) state.colour = mode;
+    render();
+    return state.colour;
+  }
+
+  // The centres last drawn on a panel, [[x, y], ...] (what the canvas shows).
+  function positions(panel = 0) {
+    const run = panels[panel].run;
+    return Array.from({ length: run.n }, (_, d) => [run.x[d], run.y[d]]);
+  }
+
+  // Writes {time, positions: [panel][disc][x, y]} into <pre id="ds-readout"> for tools that read the DOM.
+  function readout() {
+    const out = { time: state.t, drawn: panels.map((p) => p.run.drawnTime), positions: panels.map((_, k) => positions(k)) };
+    const text = JSON.stringify(out);
+    document.getElementById("ds-readout").textContent = text;
+    return text;
+  }
+
+  document.addEventListener("keydown", (e) => {
+    if (e.target && ["INPUT", "SELECT"].includes(e.target.tagName) && e.target.type !== "range") return;
+    if (e.key === " ") { toggle(); e.preventDefault(); }
+    else if (e.key === "ArrowRight") { if (e.shiftKey) nextEvent(); else step(1); e.preventDefault(); }
+    else if (e.key === "ArrowLeft") { if (e.shiftKey) previousEvent(); else step(-1); e.preventDefault(); }
+    else if (e.key === "Home") seek(T0);
+    else if (e.key === "End") seek(T1);
+  });
+  window.addEventListener("resize", () => { layout(); render(); });
+
+  window.discsim = {
+    seek, time: () => state.t, positions, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
+    setColour, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
+    labels: runs.map((r) => r.label), eventTimes: () => eventTimes.slice(),
+  };
+
+  layout();
+  const fromHash = /(?:^#|&)t=([^&]+)/.exec(window.location.hash);
+  state.t = fromHash && Number.isFinite(Number(fromHash[1])) ? Math.min(T1, Math.max(T0, Number(fromHash[1]))) : T0;
+  render();
+})();

@@ -1,0 +1,492 @@
+"""Watch a run in a browser: one self-contained HTML page that replays the exact motion from the event log.
+
+:func:`view` writes a single HTML file (no network: the script, the style and the data are inline) that
+replays a run of either engine, or several side by side (PIT against PIC), at any playback speed and frame
+rate, with play, pause, step, a time scrubber, discs coloured by disc, group or speed, and the exact
+contacts marked. Between events discs fly straight, so the page rebuilds every position exactly as
+:func:`discsim.trajectory.reconstruct` does, with the same floating-point operations (the same numbers, bit
+for bit): it holds the discs' state where the replay starts and each disc's state after each of its events.
+
+In the page, ``window.discsim`` is a small API for scripts and tests: ``seek(t)``, ``time()``,
+``positions(panel)`` (the centres last drawn, ``(N, 2)`` as nested lists), ``play()``, ``pause()``,
+``step(frames)``, ``nextEvent()``, ``previousEvent()``, ``setSpeed(s)``, ``setFps(f)``, ``setColour(mode)``.
+A page opened as ``view.html#t=1.25`` starts at that time.
+
+Typical use::
+
+    pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate).run(until=case.until)
+    ds.view(pic, "case.html", compare_with=pit)       # PIT left, PIC right, the exact contacts marked
+    ds.view("run-folder")                              # a folder written by `discsim run --out run-folder`
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from discsim.errors import InvalidArgumentError
+from discsim.events import COLLISION, EVENT_DTYPE
+
+__all__ = ["COLOUR_MODES", "DEFAULT_MAX_EVENTS", "View", "view"]
+
+#: How discs can be coloured: each disc its own colour, by collision group, or by speed (a colour scale).
+COLOUR_MODES = ("auto", "disc", "group", "speed")
+#: At most this many events (all runs together, within the shown span) unless ``max_events`` says otherwise:
+#: about 140 bytes of page each (a collision holds both discs' state after it).
+DEFAULT_MAX_EVENTS = 250_000
+#: The files of a run folder written by ``discsim run --out DIR`` that the viewer reads.
+RUN_FOLDER_FILES = ("events.dse", "state.dsc")
+
+_ASSETS = Path(__file__).parent / "_assets"
+
+
+@dataclass(frozen=True)
+class _Run:
+    """One run reduced to what the page needs: the scene, the span and the log."""
+
+    label: str
+    engine: str
+    radii: np.ndarray
+    masses: np.ndarray
+    groups: np.ndarray
+    box: object
+    segments: tuple
+    positions0: np.ndarray
+    velocities0: np.ndarray
+    start_time: float
+    end_time: float
+    events: np.ndarray
+    dt: float | None
+
+
+# --- reading the sources ---------------------------------------------------------------------------------
+
+
+def _from_engine(sim, label: str | None) -> _Run:
+    name = type(sim).__name__
+    stream = getattr(sim, "_stream", None)
+    if stream is not None:  # the run streamed its log to disk: replay the file, with the engine's scene
+        from discsim.io.streams import read_events
+
+        log = read_events(stream["path"], partial=True)
+        return _from_stream(log, label or name, name, getattr(sim, "segments", ()), getattr(sim, "dt", None))
+    if not getattr(sim, "record", True):
+        msg = (
+            f"cannot view this {name}: it was built with record=False, so it recorded no event log to replay; "
+            "build it with record=True, or stream its log with run(record_to=PATH) and view PATH"
+        )
+        raise InvalidArgumentError(msg)
+    events = sim.events  # names the file when the log was streamed to disk
+    discs = sim.discs
+    dt = getattr(sim, "dt", None)
+    return _Run(
+        label=label or name,
+        engine=name,
+        radii=discs.radii,
+        masses=discs.masses,
+        groups=discs.groups,
+        box=sim.box,
+        segments=tuple(getattr(sim, "segments", ())),
+        positions0=discs.positions,
+        velocities0=discs.velocities,
+        start_time=float(sim.start_time),
+        end_time=float(sim.time),
+        events=events,
+        dt=float(dt) if dt else None,
+    )
+
+
+def _from_stream(log, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
+    d = log.discs
+    return _Run(
+        label=label,
+        engine=engine,
+        radii=d.radii,
+        masses=d.masses,
+        groups=d.groups,
+        box=log.box,
+        segments=tuple(segments),
+        positions0=d.positions,
+        velocities0=d.velocities,
+        start_time=float(log.start_time),
+        end_time=float(log.end_time),
+        events=log.events,
+        dt=dt,
+    )
+
+
+def _checkpoint_scene(path: Path):
+    """``(engine name, segments, dt)`` stored in a checkpoint, without building the engine."""
+    from discsim.io.container import read_state
+    from discsim.model import Segment
+
+    meta, _ = read_state(path)
+    ends = (meta.get("scene") or {}).get("segments") or []
+    segments = [Segment(s[:2], s[2:]) for s in ends]
+    dt = (meta.get("settings") or {}).get("dt")
+    return str(meta.get("engine", "EventDriven")), segments, (float(dt) if dt else None)
+
+
+def _from_path(path: Path, label: str | None) -> _Run:
+    from discsim.io.checkpoints import load
+    from discsim.io.container import STATE_MAGIC
+    from discsim.io.streams import read_events
+
+    if not path.exists():
+        msg = f"cannot view {str(path)!r}: no such file or folder"
+        raise InvalidArgumentError(msg)
+    if path.is_dir():
+        events_file, checkpoint = (path / name for name in RUN_FOLDER_FILES)
+        if not events_file.exists():
+            if checkpoint.exists():
+                return _from_path(checkpoint, label or path.name)
+            msg = (
+                f"cannot view the folder {str(path)!r}: it holds no event log ({RUN_FOLDER_FILES[0]}) and no "
+                f"checkpoint ({RUN_FOLDER_FILES[1]}); a run folder is written by `discsim run --out FOLDER`"
+            )
+            raise InvalidArgumentError(msg)
+        log = read_events(events_file, partial=True)
+        engine, segments, dt = _checkpoint_scene(checkpoint) if checkpoint.exists() else ("EventDriven", (), None)
+        return _from_stream(log, label or path.name, engine, segments, dt)
+    with path.open("rb") as handle:
+        is_state = handle.read(len(STATE_MAGIC)) == STATE_MAGIC
+    if not is_state:  # an event log (read_events names what else it may be)
+        return _from_stream(read_events(path, partial=True), label or path.name)
+    sim = load(path)  # a checkpoint: its log is in it, or was streamed to a file it names
+    stream = sim._stream
+    if stream is not None:
+        log_path = Path(stream["path"])
+        if not log_path.is_absolute() and not log_path.exists():
+            log_path = path.parent / log_path.name
+        _, segments, dt = _checkpoint_scene(path)
+        return _from_stream(read_events(log_path, partial=True), label or path.name, type(sim).__name__, segments, dt)
+    return _from_engine(sim, label or path.name)
+
+
+def _as_run(source, label: str | None) -> _Run:
+    from discsim.engines.base import Engine
+    from discsim.io.streams import StreamedEvents
+
+    if isinstance(source, _Run):
+        return source
+    if isinstance(source, (str, Path)):
+        return _from_path(Path(source), label)
+    if isinstance(source, StreamedEvents):
+        return _from_stream(source, label or "event log")
+    if isinstance(source, Engine):
+        return _from_engine(source, label)
+    msg = (
+        f"cannot view a {type(source).__name__}: give an engine (EventDriven or FixedStep, record=True), "
+        "a run folder or event-log path, or the StreamedEvents of ds.read_events"
+    )
+    raise InvalidArgumentError(msg)
+
+
+# --- packing the data ------------------------------------------------------------------------------------
+
+
+def _b64(array: np.ndarray, dtype: str) -> str:
+    return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
+
+
+def _records(run: _Run, t0: float, t1: float):
+    """Each disc's state records within ``[t0, t1]``, as :func:`discsim.trajectory.reconstruct` orders them.
+
+    Returns ``(starts (N + 1,), times (R,), states (R, 4), partners (R,))``: disc ``d`` owns records
+    ``starts[d]:starts[d + 1]``, sorted by time then log order; a record holds ``x, y, vx, vy`` after the
+    event at ``times``; ``partners`` is -2 for the state where the log starts, -1 for a wall hit, else the
+    other disc. A disc keeps its last record at or before ``t0`` (which may be the initial state), so that
+    positions in ``[t0, t1]`` come from the same records, and the same arithmetic, as ``trajectory()``.
+    """
+    n = len(run.radii)
+    events = run.events[run.events["time"] <= t1]
+    pair = np.flatnonzero(events["j"] >= 0)
+    ev = events[pair]
+    disc = np.concatenate([np.arange(n), events["i"], ev["j"]])
+    times = np.concatenate([np.full(n, run.start_time), events["time"], ev["time"]])
+    seq = np.concatenate([np.full(n, -1), np.arange(len(events)), pair])
+    partner = np.concatenate([np.full(n, -2), events["j"], ev["i"]])
+    states = np.vstack(
+        [
+            np.hstack([run.positions0, run.velocities0]),
+            np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]),
+            np.column_stack([ev["xj"], ev["yj"], ev["vxj"], ev["vyj"]]),
+        ]
+    )
+    order = np.lexsort((seq, times, disc))  # by disc, then time, then log order
+    disc, times, partner, states = disc[order], times[order], partner[order], states[order]
+    # Drop a record when the same disc has a later one still at or before t0.
+    superseded = np.zeros(len(disc), dtype=bool)
+    superseded[:-1] = (disc[1:] == disc[:-1]) & (times[1:] <= t0)
+    keep = ~superseded
+    disc, times, partner, states = disc[keep], times[keep], partner[keep], states[keep]
+    starts = np.searchsorted(disc, np.arange(n + 1))
+    return starts, times, states, partner
+
+
+def _span(runs: list[_Run], start, until) -> tuple[float, float]:
+    lo = max(r.start_time for r in runs)
+    hi = min(r.end_time for r in runs)
+    t0 = lo if start is None else float(start)
+    t1 = hi if until is None else float(until)
+    if not (math.isfinite(t0) and math.isfinite(t1)):
+        msg = f"start and until must be finite times, got start={start!r}, until={until!r}"
+        raise InvalidArgumentError(msg)
+    if t0 < lo or t1 > hi or t1 < t0:
+        what = "the span every run covers" if len(runs) > 1 else "the run's span"
+        msg = f"cannot show t in [{t0!r}, {t1!r}]: {what} is [{lo!r}, {hi!r}]"
+        raise InvalidArgumentError(msg)
+    return t0, t1
+
+
+def _run_data(run: _Run, t0: float, t1: float, truth: bool) -> dict:
+    starts, times, states, partners = _records(run, t0, t1)
+    box = run.box
+    ev = run.events
+    contacts = ev[(ev["kind"] == COLLISION) & (ev["time"] >= t0) & (ev["time"] <= t1)]
+    speeds = np.hypot(states[:, 2], states[:, 3])
+    return {
+        "label": run.label,
+        "engine": run.engine,
+        "dt": run.dt,
+        "truth": truth,
+        "n": len(run.radii),
+        "box": {"width": float(box.width), "height": float(box.height), "periodic": bool(box.periodic)},
+        "segments": [[*map(float, s.p0), *map(float, s.p1)] for s in run.segments],
+        "radii": _b64(run.radii, "<f8"),
+        "fixed": _b64(np.isinf(run.masses), "u1"),
+        "groups": _b64(run.groups, "<i4"),
+        "starts": _b64(starts, "<i4"),
+        "times": _b64(times, "<f8"),
+        "states": _b64(states, "<f8"),
+        "partners": _b64(partners, "<i4"),
+        "contact_times": _b64(contacts["time"], "<f8"),
+        "contact_pairs": _b64(np.column_stack([contacts["i"], contacts["j"]]), "<i4"),
+        "max_speed": float(np.quantile(speeds, 0.99)) if len(speeds) else 0.0,  # the fastest 1% saturate
+    }
+
+
+def _check_nonempty(run: _Run) -> None:
+    if run.end_time <= run.start_time and not len(run.events):
+        msg = (
+            f"cannot view {run.label!r}: it recorded nothing (no event, and no time elapsed: "
+            f"t = {run.start_time!r}); run it first, e.g. sim.run(until=...)"
+        )
+        raise InvalidArgumentError(msg)
+    if run.events.dtype != EVENT_DTYPE:
+        msg = f"cannot view {run.label!r}: its log is not of the event dtype ({run.events.dtype})"
+        raise InvalidArgumentError(msg)
+
+
+def _panel_labels(runs: list[_Run], labels) -> list[str]:
+    if labels is not None:
+        labels = [str(x) for x in labels]
+        if len(labels) != len(runs):
+            msg = f"labels must name each of the {len(runs)} runs, got {len(labels)}"
+            raise InvalidArgumentError(msg)
+        return labels
+    out = []
+    for r in runs:
+        if r.engine == "FixedStep" and r.dt:
+            out.append(f"PIT ({r.label}, {1.0 / r.dt:.3g} frames per unit time)")
+        elif r.engine == "EventDriven" and len(runs) > 1:
+            out.append(f"PIC ({r.label}), the truth")
+        else:
+            out.append(r.label)
+    return out
+
+
+# --- the page --------------------------------------------------------------------------------------------
+
+
+class View:
+    """A replay page made by :func:`view`: the HTML text, and the file it was written to (if any).
+
+    In Jupyter the object shows itself inline (an ``iframe`` whose ``srcdoc`` is the page).
+
+    Attributes:
+        html: the whole page, one self-contained HTML document (str).
+        path: the file written, or None.
+        span: ``(t0, t1)``, the simulated times the page replays.
+        events: the number of events it holds (all runs together).
+    """
+
+    def __init__(self, html_text: str, path: Path | None, span: tuple[float, float], events: int, height: int):
+        self.html = html_text
+        self.path = path
+        self.span = span
+        self.events = events
+        self._height = height
+
+    def save(self, path) -> Path:
+        """Write the page to ``path`` (its folder is created) and return the path."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(self.html, encoding="utf-8")
+        self.path = path
+        return path
+
+    def _repr_html_(self) -> str:
+        return (
+            f'<iframe srcdoc="{html.escape(self.html, quote=True)}" '
+            f'style="width: 100%; height: {self._height}px; border: 0" sandbox="allow-scripts"></iframe>'
+        )
+
+    def __repr__(self) -> str:
+        where = f", path={str(self.path)!r}" if self.path else ""
+        return f"View(span={self.span}, events={self.events}, {len(self.html):,} bytes{where})"
+
+
+def view(
+    source,
+    path="view.html",
+    *,
+    compare_with=None,
+    labels=None,
+    colour: str = "auto",
+    speed: float | None = None,
+    fps: float = 30.0,
+    start: float | None = None,
+    until: float | None = None,
+    contact_window: float | None = None,
+    max_events: int = DEFAULT_MAX_EVENTS,
+    title: str | None = None,
+) -> View:
+    """Write a self-contained HTML page that replays runs exactly, from their event logs.
+
+    Args:
+        source: what to replay: an engine (``EventDriven`` or ``FixedStep``, built with ``record=True``), a
+            run folder written by ``discsim run --out FOLDER``, an event-log file (``run(record_to=...)``)
+            or a checkpoint, the :class:`~discsim.io.streams.StreamedEvents` of :func:`discsim.read_events`;
+            or a list of these, drawn side by side on one clock (e.g. ``[pit, pic]``).
+        path: the HTML file to write (its folder is created); None writes nothing (the returned
+            :class:`View` still holds the page, e.g. to show it in Jupyter).
+        compare_with: another run (or list of runs) drawn to the left of ``source``: ``view(pic,
+            compare_with=pit)`` draws PIT left and PIC right, like the study's figures.
+        labels: one title per panel; default the engine and, for PIT, its frame rate.
+        colour: ``"disc"`` (each disc its own colour), ``"group"`` (by collision group), ``"speed"`` (viridis
+            from 0 to the 99th percentile of the speeds in the replay), or ``"auto"``: ``"disc"`` up to 20
+            discs, else ``"group"`` when the groups differ, else ``"speed"``. Fixed obstacles are grey.
+            The page can switch.
+        speed: playback speed in simulated time per second of real time; default the span over 10 s
+            (at least one frame interval of a PIT run per 0.25 s). The page can change it.
+        fps: frames drawn per second of real time while playing.
+        start, until: the span of simulated time to replay (default all that every run covers).
+        contact_window: exact contacts (collisions of the event-driven runs) are drawn as outlines from
+            their time on, for this long in simulated time; default: for ever when the runs hold at most
+            60 contacts, else 2% of the span.
+        max_events: refuse to write a page holding more events than this (about 140 bytes each): ask
+            for a shorter span with ``start``/``until``.
+        title: the page's title.
+
+    Returns:
+        A :class:`View` (``html``, ``path``, ``span``, ``events``; shows itself inline in Jupyter).
+
+    Raises:
+        InvalidArgumentError: before anything is written, for a run that recorded nothing (``record=False``,
+            or no time elapsed), a folder or file with no event log, a span outside the runs, a bad
+            ``colour``, ``speed``, ``fps``, ``labels`` or ``max_events``, or more events than ``max_events``.
+        CheckpointError: for a damaged event log or checkpoint.
+
+    Example:
+        >>> import discsim as ds
+        >>> case = ds.head_on(1.0, 2.0)
+        >>> sim = ds.EventDriven(case.discs, case.box).run(until=case.until)
+        >>> page = ds.view(sim, path=None)
+        >>> page.html.startswith("<!DOCTYPE html>"), page.events == len(sim.events), "http" in page.html
+        (True, True, False)
+    """
+    sources = list(source) if isinstance(source, Sequence) and not isinstance(source, str) else [source]
+    if compare_with is not None:
+        others = (
+            list(compare_with)
+            if isinstance(compare_with, Sequence) and not isinstance(compare_with, str)
+            else [compare_with]
+        )
+        sources = others + sources
+    if not sources:
+        msg = "view() needs at least one run"
+        raise InvalidArgumentError(msg)
+    if colour not in COLOUR_MODES:
+        msg = f"colour must be one of {', '.join(map(repr, COLOUR_MODES))}, got {colour!r}"
+        raise InvalidArgumentError(msg)
+    for name, value in (("speed", speed), ("fps", fps), ("contact_window", contact_window)):
+        if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            msg = f"{name} must be a positive finite number, got {value!r}"
+            raise InvalidArgumentError(msg)
+    if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
+        msg = f"max_events must be a positive integer, got {max_events!r}"
+        raise InvalidArgumentError(msg)
+    runs = [_as_run(s, None) for s in sources]
+    for r in runs:
+        _check_nonempty(r)
+    panel_labels = _panel_labels(runs, labels)
+    t0, t1 = _span(runs, start, until)
+    held = sum(int((r.events["time"] <= t1).sum()) for r in runs)
+    if held > max_events:
+        msg = (
+            f"the replay would hold {held:,} events, more than max_events={max_events:,} (about 140 bytes "
+            "each); choose a shorter span with start= and until= (--start/--until), or raise max_events"
+        )
+        raise InvalidArgumentError(msg)
+    has_truth = any(r.engine == "EventDriven" for r in runs)
+    data_runs = []
+    for r, label in zip(runs, panel_labels, strict=True):
+        d = _run_data(r, t0, t1, truth=r.engine == "EventDriven" or not has_truth)
+        d["label"] = label
+        data_runs.append(d)
+    if colour == "auto":
+        n, groups = len(runs[0].radii), runs[0].groups
+        colour = "disc" if n <= 20 else ("group" if len(np.unique(groups)) > 1 else "speed")
+    if speed is None:
+        speed = (t1 - t0) / 10.0 if t1 > t0 else 1.0
+        frame = max((r.dt or 0.0) for r in runs)
+        speed = max(speed, 4.0 * frame) if frame else speed
+        speed = min(speed, t1 - t0) if t1 > t0 else speed
+    n_contacts = max(int((r.events["kind"] == COLLISION).sum()) for r in runs)
+    if contact_window is None:
+        contact_window = math.inf if n_contacts <= 60 else 0.02 * (t1 - t0)
+    data = {
+        "version": 1,
+        "title": title or " | ".join(panel_labels),
+        "span": [t0, t1],
+        "speed": float(speed),
+        "fps": float(fps),
+        "colour": colour,
+        "contact_window": None if math.isinf(contact_window) else float(contact_window),
+        "runs": data_runs,
+    }
+    page = _page(data)
+    height = 760 if len(runs) > 1 else 700
+    result = View(page, None, (t0, t1), held, height)
+    if path is not None:
+        result.save(path)
+    return result
+
+
+def _page(data: dict) -> str:
+    """The HTML document: the style, the data (JSON) and the player script, all inline."""
+    script = (_ASSETS / "viewer.js").read_text(encoding="utf-8")
+    style = (_ASSETS / "viewer.css").read_text(encoding="utf-8")
+    payload = json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    title = html.escape(data["title"])
+    return (
+        "<!DOCTYPE html>\n"
+        '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        f"<title>discsim: {title}</title>\n<style>\n{style}</style>\n</head>\n<body>\n"
+        f'<header><h1>{title}</h1><p id="ds-info"></p></header>\n'
+        '<main id="ds-panels"></main>\n'
+        '<nav id="ds-controls"></nav>\n'
+        '<pre id="ds-readout" hidden></pre>\n'
+        f'<script type="application/json" id="ds-data">{payload}</script>\n'
+        f"<script>\n{script}</script>\n</body>\n</html>\n"
+    )

@@ -1,0 +1,282 @@
+"""ds.view: a self-contained replay page, checked in a real browser (headless Chromium) against trajectory().
+
+The browser tests open the page with Debian's ``chromium`` (``.ci/run`` installs it when it can), drive it
+through its JavaScript API (``window.discsim``), read the centres it drew back from the DOM
+(``--dump-dom``) and compare them with ``trajectory()`` at the same times; they skip, saying why, only when
+no Chromium binary is found.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+import re
+import shutil
+import subprocess
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.image
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim import cli
+
+CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable", "chrome")
+
+
+def chromium() -> str:
+    found = os.environ.get("DISCSIM_CHROMIUM") or next(filter(None, map(shutil.which, CHROMIUM_NAMES)), None)
+    if not found:
+        names = ", ".join(CHROMIUM_NAMES)
+        pytest.skip(f"no Chromium binary found (looked for {names} on PATH and DISCSIM_CHROMIUM): apt install chromium")
+    return found
+
+
+def browser_args(*extra) -> list[str]:
+    return [chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--mute-audio", *extra]
+
+
+def drive(page_path, tmp_path, script: str, *, budget_ms: int = 3000) -> dict:
+    """Open ``page_path`` in headless Chromium, run ``script`` (JS, after the page's own), return its readout.
+
+    ``script`` drives ``window.discsim`` and ends by calling ``discsim.readout()`` or writing JSON into
+    ``#ds-readout`` itself; ``--dump-dom`` prints the DOM once the page is idle (virtual time), and the
+    JSON is read back from it.
+    """
+    text = page_path.read_text(encoding="utf-8")
+    driven = tmp_path / f"driven-{time.monotonic_ns()}.html"
+    driven.write_text(text.replace("</body>", f"<script>\n{script}\n</script>\n</body>"), encoding="utf-8")
+    result = subprocess.run(
+        browser_args(f"--virtual-time-budget={budget_ms}", "--dump-dom", driven.as_uri()),
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    found = re.search(r'<pre id="ds-readout"[^>]*>(.*?)</pre>', result.stdout, re.S)
+    assert found and found.group(1), f"no readout in the page (exit {result.returncode}): {result.stderr[-2000:]}"
+    return json.loads(html.unescape(found.group(1)))
+
+
+SEEK_SCRIPT = """
+const out = [];
+for (const t of TIMES) {
+  discsim.seek(t);
+  out.push({time: discsim.time(), positions: Array.from({length: discsim.panels}, (_, k) => discsim.positions(k))});
+}
+document.getElementById("ds-readout").textContent = JSON.stringify(out);
+"""
+
+
+def seek_all(page_path, tmp_path, times) -> list[dict]:
+    return drive(page_path, tmp_path, SEEK_SCRIPT.replace("TIMES", json.dumps([float(t) for t in times])))
+
+
+def assert_same_positions(drawn, expected):
+    drawn = np.asarray(drawn, dtype=float)
+    assert drawn.shape == expected.shape
+    np.testing.assert_allclose(drawn, expected, rtol=1e-9, atol=1e-12 * max(1.0, float(np.abs(expected).max())))
+
+
+def case_runs(case):
+    pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate).run(until=case.until)
+    return pic, pit
+
+
+# --- in the browser ---------------------------------------------------------------------------------------
+
+
+def test_the_page_draws_pit_and_pic_where_trajectory_puts_them(tmp_path):
+    case = ds.scenarios.multiple_collisions()
+    pic, pit = case_runs(case)
+    page = ds.view(pic, tmp_path / "case3.html", compare_with=pit)
+    assert page.path == tmp_path / "case3.html" and page.path.exists()
+    events = np.concatenate([pic.events["time"], pit.events["time"]])
+    times = np.unique(np.concatenate([np.linspace(0.0, case.until, 23), events, events + 1e-7, [0.4321]]))
+    times = times[times <= case.until]
+    readout = seek_all(page.path, tmp_path, times)
+    assert [r["time"] for r in readout] == times.tolist()
+    pit_expected, pic_expected = pit.trajectory(times), pic.trajectory(times)
+    for k, r in enumerate(readout):
+        pit_drawn, pic_drawn = r["positions"]  # PIT left, PIC right
+        assert_same_positions(pit_drawn, pit_expected[k])
+        assert_same_positions(pic_drawn, pic_expected[k])
+
+
+def test_a_periodic_gas_wraps_like_trajectory_and_a_window_replays_exactly(tmp_path):
+    discs, box = ds.random_gas(150, 0.35, periodic=True, seed=3)
+    sim = ds.EventDriven(discs, box).run(until=4.0)
+    page = ds.view(sim, tmp_path / "gas.html", start=1.5, until=3.0, colour="speed")
+    assert page.span == (1.5, 3.0)
+    times = np.concatenate([np.linspace(1.5, 3.0, 7), sim.events["time"][(sim.events["time"] > 1.5)][:5]])
+    times = times[times <= 3.0]
+    readout = seek_all(page.path, tmp_path, times)
+    expected = sim.trajectory(times)
+    for k, r in enumerate(readout):
+        (drawn,) = r["positions"]
+        assert_same_positions(drawn, expected[k])
+    # Seeking outside the span clamps to it.
+    (first, last) = seek_all(page.path, tmp_path, [0.0, 99.0])
+    assert (first["time"], last["time"]) == (1.5, 3.0)
+
+
+def test_playing_advances_the_clock_and_draws_the_exact_positions(tmp_path):
+    case = ds.scenarios.delay()
+    pic, pit = case_runs(case)
+    page = ds.view([pit, pic], tmp_path / "delay.html", fps=25)
+    script = """
+discsim.setSpeed(0.5);
+discsim.play();
+setTimeout(() => {
+  discsim.pause();
+  const frames = [discsim.time()];
+  discsim.step(1); frames.push(discsim.time());
+  discsim.step(1); frames.push(discsim.time());
+  discsim.step(-1); frames.push(discsim.time());
+  discsim.seek(0.05); discsim.nextEvent(); frames.push(discsim.time());
+  discsim.seek(0.0); discsim.play();
+  setTimeout(() => {
+    discsim.pause();
+    const t = discsim.time();
+    document.getElementById("ds-readout").textContent = JSON.stringify({
+      frames, time: t, playing: discsim.playing(),
+      positions: [discsim.positions(0), discsim.positions(1)],
+    });
+  }, 1500);
+}, 1000);
+"""
+    out = drive(page.path, tmp_path, script, budget_ms=5000)
+    first, after_one, after_two, back, next_event = out["frames"]
+    assert 0.3 < first < 0.7  # about 1 s of virtual time at 0.5 time units per second
+    dt = pit.dt
+    assert after_one == pytest.approx(dt * (np.floor(first / dt) + 1), rel=1e-12)  # the next PIT frame
+    assert after_two == pytest.approx(after_one + dt, rel=1e-12) and back == pytest.approx(after_one, rel=1e-12)
+    all_events = np.concatenate([pic.events["time"], pit.events["time"]])
+    assert next_event == all_events[all_events > 0.05].min()
+    assert not out["playing"] and 0.5 < out["time"] <= case.until
+    t = out["time"]
+    assert_same_positions(out["positions"][0], pit.trajectory([t])[0])
+    assert_same_positions(out["positions"][1], pic.trajectory([t])[0])
+
+
+def test_the_screenshot_is_not_blank(tmp_path):
+    case = ds.billiard_break()
+    sim = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    page = ds.view(sim, tmp_path / "break.html")
+    shot = tmp_path / "break.png"
+    uri = page.path.as_uri() + f"#t={case.until / 2}"
+    subprocess.run(
+        browser_args("--window-size=1100,800", "--virtual-time-budget=1000", f"--screenshot={shot}", uri),
+        capture_output=True,
+        timeout=120,
+        check=False,
+    )
+    assert shot.exists(), "Chromium wrote no screenshot"
+    pixels = matplotlib.image.imread(shot)[..., :3]
+    assert pixels.shape[0] > 300 and pixels.shape[1] > 300
+    assert pixels.std() > 0.05  # discs, box, controls: far from a uniform page
+    # The discs are drawn in colour (a blank or all-grey page has equal RGB channels everywhere).
+    assert (np.ptp(pixels, axis=2) > 0.2).mean() > 0.01
+
+
+def test_a_run_folder_is_replayed_from_its_streamed_log(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert cli.main(["run", "--n", "40", "--packing", "0.3", "--until", "2", "--out", out, "--no-progress"]) == 0
+    assert cli.main(["view", out]) == 0
+    written = out / "view.html"
+    assert written.exists() and str(written) in capsys.readouterr().out
+    log = ds.read_events(out / "events.dse")
+    times = [0.0, 0.77, 2.0]
+    readout = seek_all(written, tmp_path, times)
+    expected = log.trajectory(times)
+    for k, r in enumerate(readout):
+        assert_same_positions(r["positions"][0], expected[k])
+
+
+# --- without a browser -------------------------------------------------------------------------------------
+
+
+def test_the_page_is_self_contained_and_shows_inline_in_jupyter(tmp_path):
+    case = ds.head_on(1.0, 3.0)
+    sim = ds.EventDriven(case.discs, case.box).run(until=case.until)
+    page = ds.view(sim, path=None)
+    assert page.path is None and page.events == len(sim.events) and page.span == (0.0, case.until)
+    text = page.html
+    assert "://" not in text and "<script src" not in text and "<link" not in text  # no network at all
+    assert "window.discsim" in text
+    inline = page._repr_html_()
+    assert inline.startswith("<iframe srcdoc=") and "&lt;script&gt;" not in inline[:20]
+    assert html.unescape(re.search(r'srcdoc="(.*?)"', inline, re.S).group(1)) == text
+    assert page.save(tmp_path / "sub" / "page.html").read_text(encoding="utf-8") == text
+    assert "page.html" in repr(page)
+
+
+def test_a_streamed_run_and_a_checkpoint_can_be_viewed(tmp_path):
+    discs, box = ds.random_gas(30, 0.3, seed=2)
+    sim = ds.EventDriven(discs, box, record=False).run(until=1.0, record_to=tmp_path / "events.dse")
+    from_engine = ds.view(sim, path=None)
+    from_file = ds.view(tmp_path / "events.dse", path=None)
+    from_log = ds.view(ds.read_events(tmp_path / "events.dse"), path=None)
+    assert from_engine.events == from_file.events == from_log.events > 0
+    fixed = ds.FixedStep(discs, box, frame_rate=20.0).run(until=0.5)
+    fixed.save(tmp_path / "fixed.dsc")
+    again = ds.view(tmp_path / "fixed.dsc", path=None)
+    assert again.events == len(fixed.events) and "PIT (fixed.dsc, 20 frames per unit time)" in again.html
+    both = ds.view(ds.EventDriven(discs, box).run(until=0.5), path=None, compare_with=tmp_path / "fixed.dsc")
+    assert "PIT (fixed.dsc, 20 frames per unit time) | PIC (EventDriven), the truth" in both.html
+
+
+@pytest.mark.parametrize(
+    ("make", "kwargs", "match"),
+    [
+        (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2), record=False).run(until=1.0), {}, "record=False"),
+        (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)), {}, "recorded nothing"),
+        (lambda p: ds.FixedStep(*ds.random_gas(10, 0.2)), {}, "recorded nothing"),
+        (lambda p: p / "missing", {}, "no such file or folder"),
+        (lambda p: p, {}, "holds no event log"),
+        (lambda p: object(), {}, "cannot view a object"),
+        (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"colour": "mass"}, "colour must be"),
+        (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"until": 2.0}, r"\[0.0, 1.0\]"),
+        (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"speed": -1.0}, "speed must be"),
+        (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"labels": ["a", "b"]}, "labels must"),
+        (lambda p: ds.EventDriven(*ds.random_gas(30, 0.3)).run(until=3.0), {"max_events": 10}, "max_events=10"),
+        (lambda p: [], {}, "at least one run"),
+    ],
+)
+def test_bad_input_is_refused_by_name_before_anything_is_written(tmp_path, make, kwargs, match):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    source = make(empty)
+    with pytest.raises(ds.DiscsimError, match=match):
+        ds.view(source, tmp_path / "view.html", **kwargs)
+    assert not (tmp_path / "view.html").exists()
+
+
+def test_the_command_line_refuses_a_folder_that_recorded_nothing(tmp_path, capsys):
+    assert cli.main(["view", tmp_path]) == 1
+    err = capsys.readouterr().err
+    assert "discsim view:" in err and "holds no event log" in err
+    assert not list(tmp_path.iterdir())
+
+
+def test_only_the_front_door_and_the_command_line_import_the_viewer():
+    import ast
+    from pathlib import Path
+
+    package = Path(ds.__file__).parent
+    importers = set()
+    for path in package.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [node.module] if isinstance(node, ast.ImportFrom) else []
+            names += [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if "discsim.view" in names:
+                importers.add(path.relative_to(package).as_posix())
+    assert importers == {"__init__.py", "cli.py"}
+    assert "matplotlib" not in (package / "view.py").read_text()  # `import discsim` stays free of matplotlib

@@ -5,3 +5,26 @@ import matplotlib
 
 matplotlib.use("Agg")
 sys.path.insert(0, os.path.dirname(__file__))  # so tests can import the oracle module
+
+
+import pytest
+
+from discsim import _numba
+
+#: The backends every engine test runs against (numba ones skip when numba is missing or hidden).
+BACKENDS = ("python", "numba")
+
+
+@pytest.fixture(params=BACKENDS)
+def every_backend(request, monkeypatch):
+    """Run the test once per backend: ``backend="auto"`` (the default) then picks that backend.
+
+    For ``"python"`` numba is hidden (as ``DISCSIM_NO_NUMBA=1`` does), so ``"auto"`` falls back to the
+    pure-Python loop; ``"numba"`` is skipped when numba is not installed (the ``fast`` extra).
+    """
+    if request.param == "python":
+        monkeypatch.setattr(_numba, "_module", None)
+        monkeypatch.setattr(_numba, "_tried", True)
+    elif not _numba.available():
+        pytest.skip("numba is not installed or is hidden (the fast extra)")
+    return request.param

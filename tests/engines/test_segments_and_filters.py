@@ -9,6 +9,8 @@ from oracle import next_event
 import discsim as ds
 from discsim.kernels import segment_time_of_impact
 
+pytestmark = pytest.mark.usefixtures("every_backend")  # every test once per backend
+
 
 def test_disc_bounces_off_a_segment_face_at_the_exact_time():
     seg = ds.Segment((2.0, 5.0), (8.0, 5.0))

@@ -120,12 +120,13 @@ class NumbaBackend:
         self._qs[owners] = state.queue_stamp
         self._heap = np.zeros(n, dtype=np.int64)
         self._heap[: len(owners)] = owners
+        self._ht = np.zeros(n)
         self._hpos = np.full(n, -1, dtype=np.int64)
         lp = self._lp
         ints = self._ints = np.zeros(lp.N_INTS, dtype=np.int64)
         floats = self._floats = np.zeros(lp.N_FLOATS)
         ints[lp.I_SIZE] = len(owners)
-        lp.heapify(self._heap, self._hpos, self._qt, ints)
+        lp.heapify(self._heap, self._ht, self._hpos, self._qt, ints)
         ints[lp.I_PRED] = state.predictions
         ints[lp.I_COLL] = state.collisions
         ints[lp.I_WALL] = state.wall_hits
@@ -328,6 +329,7 @@ class NumbaBackend:
         """Assert the backend's own invariants (heap order and positions, linked cells); O(N)."""
         size, heap, hpos, qt = self.queue_size(), self._heap, self._hpos, self._qt
         owners = heap[:size]
+        assert np.array_equal(self._ht[:size], qt[owners]), "heap times out of date"
         assert np.array_equal(hpos[owners], np.arange(size)), "heap positions out of date"
         assert (hpos >= 0).sum() == size and np.isfinite(qt[owners]).all()
         parents = owners[(np.arange(1, size) - 1) >> 1]
@@ -348,7 +350,7 @@ class NumbaBackend:
         return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)
 
     def _queue(self) -> tuple:
-        return (self._heap, self._hpos, self._qt, self._qk, self._qo, self._qs, self._ints)
+        return (self._heap, self._ht, self._hpos, self._qt, self._qk, self._qo, self._qs, self._ints)
 
     def _predict_args(self) -> tuple:
         return (

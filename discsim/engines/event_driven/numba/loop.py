@@ -33,7 +33,7 @@ if _nb is None:  # pragma: no cover - the backend imports this module only when 
 
 # error_model="numpy": a division by zero gives inf or nan instead of a check on every division; the
 # loop divides only by numbers it has tested, as the Python backend does.
-jit = _nb.njit(cache=True, nogil=True, error_model="numpy")
+jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT = 0, 1, 2, 3
@@ -52,52 +52,60 @@ DONE, MORE, CROSSINGS = 0, 1, 2
 
 
 # --- the queue: an indexed binary heap of owners, ordered by (time, owner) ------------------------------
+# ``heap[k]`` is the owner at position k and ``ht[k]`` its time (kept beside it, so that a comparison reads
+# no other array); ``hpos[owner]`` is the owner's position, -1 when it has no pending event. ``qt[owner]``
+# holds the same time for reads by owner.
 @jit
-def _before(a, b, qt):
-    return qt[a] < qt[b] or (qt[a] == qt[b] and a < b)
-
-
-@jit
-def _sift_up(k, heap, hpos, qt):
+def _sift_up(k, heap, ht, hpos):
     owner = heap[k]
+    t = ht[k]
     while k > 0:
         parent = (k - 1) >> 1
+        pt = ht[parent]
         p = heap[parent]
-        if _before(owner, p, qt):
+        if t < pt or (t == pt and owner < p):
             heap[k] = p
+            ht[k] = pt
             hpos[p] = k
             k = parent
         else:
             break
     heap[k] = owner
+    ht[k] = t
     hpos[owner] = k
 
 
 @jit
-def _sift_down(k, size, heap, hpos, qt):
+def _sift_down(k, size, heap, ht, hpos):
     owner = heap[k]
+    t = ht[k]
     while True:
         child = 2 * k + 1
         if child >= size:
             break
         c = heap[child]
+        ct = ht[child]
         if child + 1 < size:
             d = heap[child + 1]
-            if _before(d, c, qt):
+            dt = ht[child + 1]
+            if dt < ct or (dt == ct and d < c):
                 child += 1
                 c = d
-        if _before(c, owner, qt):
+                ct = dt
+        if ct < t or (ct == t and c < owner):
             heap[k] = c
+            ht[k] = ct
             hpos[c] = k
             k = child
         else:
             break
     heap[k] = owner
+    ht[k] = t
     hpos[owner] = k
 
 
 @jit
-def _remove(owner, heap, hpos, qt, ints):
+def _remove(owner, heap, ht, hpos, ints):
     """Take ``owner``'s event out of the heap (it must be there)."""
     k = hpos[owner]
     hpos[owner] = -1
@@ -107,50 +115,59 @@ def _remove(owner, heap, hpos, qt, ints):
         return
     last = heap[size]
     heap[k] = last
+    ht[k] = ht[size]
     hpos[last] = k
-    if k > 0 and _before(last, heap[(k - 1) >> 1], qt):
-        _sift_up(k, heap, hpos, qt)
+    parent = (k - 1) >> 1
+    if k > 0 and (ht[k] < ht[parent] or (ht[k] == ht[parent] and last < heap[parent])):
+        _sift_up(k, heap, ht, hpos)
     else:
-        _sift_down(k, size, heap, hpos, qt)
+        _sift_down(k, size, heap, ht, hpos)
 
 
 @jit
-def push(owner, t, kind, other, stamp, heap, hpos, qt, qk, qo, qs, ints):
-    """Schedule ``owner``'s event at ``t`` (finite), replacing its pending one."""
-    k = hpos[owner]
-    old = qt[owner]
+def push(owner, t, kind, other, stamp, heap, ht, hpos, qt, qk, qo, qs, ints):
+    """Schedule ``owner``'s event at ``t`` (finite), replacing its pending one.
+
+    The loop leaves a popped event at the top of the heap until its owner is predicted again, so
+    that the new event replaces it with one sift instead of a removal and an insertion.
+    """
     qt[owner] = t
     qk[owner] = kind
     qo[owner] = other
     qs[owner] = stamp
+    k = hpos[owner]
     if k < 0:
         k = ints[I_SIZE]
         ints[I_SIZE] = k + 1
         heap[k] = owner
-        hpos[owner] = k
-        _sift_up(k, heap, hpos, qt)
-    elif t < old:  # same owner: the key moved earlier
-        _sift_up(k, heap, hpos, qt)
+        ht[k] = t
+        _sift_up(k, heap, ht, hpos)
+        return
+    old = ht[k]
+    ht[k] = t
+    if t < old:  # the same owner: only the time decides
+        _sift_up(k, heap, ht, hpos)
     else:
-        _sift_down(k, ints[I_SIZE], heap, hpos, qt)
+        _sift_down(k, ints[I_SIZE], heap, ht, hpos)
 
 
 @jit
-def discard(owner, heap, hpos, qt, ints):
+def discard(owner, heap, ht, hpos, qt, ints):
     """Drop ``owner``'s pending event, if any."""
     if hpos[owner] >= 0:
-        _remove(owner, heap, hpos, qt, ints)
+        _remove(owner, heap, ht, hpos, ints)
     qt[owner] = INF
 
 
 @jit
-def heapify(heap, hpos, qt, ints):
-    """Rebuild the heap from the owners it holds (after every time moved: ties may have appeared)."""
+def heapify(heap, ht, hpos, qt, ints):
+    """Rebuild the heap of the owners it holds from their times ``qt`` (after every time moved)."""
     size = ints[I_SIZE]
     for k in range(size):
+        ht[k] = qt[heap[k]]
         hpos[heap[k]] = k
     for k in range((size >> 1) - 1, -1, -1):
-        _sift_down(k, size, heap, hpos, qt)
+        _sift_down(k, size, heap, ht, hpos)
 
 
 # --- geometry ------------------------------------------------------------------------------------------
@@ -215,7 +232,7 @@ def predict(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, width, height, periodic, col_lo, row_lo,
     seg, seg_start, seg_idx, filtering, group, blocked,
-    heap, hpos, qt, qk, qo, qs, ints,
+    heap, ht, hpos, qt, qk, qo, qs, ints,
 ):  # fmt: skip
     """Schedule disc ``i``'s earliest event after ``t``, as the Python backend's ``predict`` does.
 
@@ -362,11 +379,11 @@ def predict(
     # 3. Schedule the earlier of the two.
     t_best = t + best
     if t_hit <= t_best and partner >= 0:
-        push(i, t_hit, COLLISION, partner, count[partner], heap, hpos, qt, qk, qo, qs, ints)
+        push(i, t_hit, COLLISION, partner, count[partner], heap, ht, hpos, qt, qk, qo, qs, ints)
     elif best == INF:
-        discard(i, heap, hpos, qt, ints)
+        discard(i, heap, ht, hpos, qt, ints)
     else:
-        push(i, t_best, kind, other, 0, heap, hpos, qt, qk, qo, qs, ints)
+        push(i, t_best, kind, other, 0, heap, ht, hpos, qt, qk, qo, qs, ints)
 
 
 @jit
@@ -374,7 +391,7 @@ def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, width, height, periodic, col_lo, row_lo,
     seg, seg_start, seg_idx, filtering, group, blocked,
-    heap, hpos, qt, qk, qo, qs, ints,
+    heap, ht, hpos, qt, qk, qo, qs, ints,
 ):  # fmt: skip
     """The start of a run: predict every moving disc at time 0, in internal order."""
     for i in range(rec.shape[0]):
@@ -383,7 +400,7 @@ def predict_all(
                 i, 0.0, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qt, qk, qo, qs, ints,
             )  # fmt: skip
     ints[I_MAXQ] = ints[I_SIZE]
 
@@ -451,13 +468,13 @@ def _enter(i, c, head, tail, nxt, prv):
 
 # --- the hot loop --------------------------------------------------------------------------------------
 @jit
-def rebase(shift, rec, heap, hpos, qt, ints, floats):
+def rebase(shift, rec, heap, ht, hpos, qt, ints, floats):
     """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``."""
     for i in range(rec.shape[0]):
         rec[i, T] -= shift
         rec[i, KEPT] = rec[i, KEPT] - shift
         qt[i] = qt[i] - shift
-    heapify(heap, hpos, qt, ints)
+    heapify(heap, ht, hpos, qt, ints)
     floats[F_EPOCH] += shift
 
 
@@ -467,7 +484,7 @@ def run_events(
     rec, count, order, images, kept_partner, kept_stamp, cell, head, tail, nxt, prv,
     nx, ny, width, height, periodic, col_lo, row_lo,
     seg, seg_start, seg_idx, filtering, group, blocked,
-    heap, hpos, qt, qk, qo, qs, ints, floats,
+    heap, ht, hpos, qt, qk, qo, qs, ints, floats,
     ev_t, ev_kind, ev_i, ev_j, ev_f,
 ):  # fmt: skip
     """Process events with times <= ``until``: the Python backend's ``_process_events``, compiled.
@@ -502,12 +519,12 @@ def run_events(
         if ints[I_SIZE] == 0:
             break
         i = heap[0]
-        t = qt[i]
+        t = ht[0]
         if t > horizon:
             break
         pops += 1
-        _remove(i, heap, hpos, qt, ints)
-        qt[i] = INF
+        # The event stays at the top of the heap: predicting i again, as every branch below does,
+        # replaces it (see push).
         kind = qk[i]
         other = qo[i]
         if kind == COLLISION:
@@ -518,7 +535,7 @@ def run_events(
                     i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, width, height, periodic, col_lo, row_lo,
                     seg, seg_start, seg_idx, filtering, group, blocked,
-                    heap, hpos, qt, qk, qo, qs, ints,
+                    heap, ht, hpos, qt, qk, qo, qs, ints,
                 )  # fmt: skip
                 continue
             vxi = rec[i, VX]
@@ -573,7 +590,7 @@ def run_events(
                 i, t, j, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qt, qk, qo, qs, ints,
             )  # fmt: skip
             if mj != INF:  # obstacles never move, and their counter never changes
                 count[j] += 1
@@ -581,7 +598,7 @@ def run_events(
                     j, t, i, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, width, height, periodic, col_lo, row_lo,
                     seg, seg_start, seg_idx, filtering, group, blocked,
-                    heap, hpos, qt, qk, qo, qs, ints,
+                    heap, ht, hpos, qt, qk, qo, qs, ints,
                 )  # fmt: skip
                 if ints[I_SIZE] > max_queue:
                     max_queue = ints[I_SIZE]
@@ -619,7 +636,7 @@ def run_events(
                 i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qt, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
         else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
@@ -659,7 +676,7 @@ def run_events(
                 i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qt, qk, qo, qs, ints,
             )  # fmt: skip
             if n_cross == crossings:
                 now = t
@@ -669,7 +686,7 @@ def run_events(
         now = t
         have_now = True
         if done >= rebase_at:
-            rebase(now, rec, heap, hpos, qt, ints, floats)
+            rebase(now, rec, heap, ht, hpos, qt, ints, floats)
             epoch = floats[F_EPOCH]
             now = 0.0
             horizon = until - epoch

@@ -26,10 +26,12 @@ from discsim.errors import (
     Interrupted,
     InvalidArgumentError,
     InvalidDiscsError,
+    JammedError,
     OutsideBoxError,
     OverlapError,
     PackingError,
     TimeError,
+    UnitsError,
 )
 from discsim.events import EVENT_DTYPE, Event, EventKind
 from discsim.io.checkpoints import checkpoint_info, load, resume
@@ -73,6 +75,7 @@ __all__ = [
     "Interrupted",
     "InvalidArgumentError",
     "InvalidDiscsError",
+    "JammedError",
     "Observer",
     "OutsideBoxError",
     "OverlapError",
@@ -82,6 +85,7 @@ __all__ = [
     "Segment",
     "StreamedEvents",
     "TimeError",
+    "UnitsError",
     "View",
     "billiard_break",
     "checkpoint_info",

@@ -14,10 +14,12 @@ __all__ = [
     "Interrupted",
     "InvalidArgumentError",
     "InvalidDiscsError",
+    "JammedError",
     "OutsideBoxError",
     "OverlapError",
     "PackingError",
     "TimeError",
+    "UnitsError",
 ]
 
 
@@ -51,6 +53,18 @@ class PackingError(DiscsimError, ValueError):
 
 class TimeError(DiscsimError, ValueError):
     """A time that lies in the simulated past, or is not finite."""
+
+
+class JammedError(DiscsimError, RuntimeError):
+    """Discs wedged against each other (or a wall) collide for ever without the clock moving.
+
+    Raised by a run after many events in a row at one instant (see ``EventDriven.jam_events``); the message
+    names the jammed discs and the time. The engine is consistent at its last whole event.
+    """
+
+
+class UnitsError(DiscsimError, ValueError):
+    """A length or speed outside the range the exact time of impact supports (see ``discsim.model.SCALE_RANGE``)."""
 
 
 class CheckpointError(DiscsimError, ValueError):

@@ -13,13 +13,13 @@ import math
 import numpy as np
 
 from discsim._numba import resolve_backend
-from discsim.cells import CellGrid
+from discsim.cells import CellGrid, neighbour_pairs
 from discsim.engines.base import Engine
 from discsim.engines.event_driven.numba import NumbaBackend
 from discsim.engines.event_driven.protocol import Backend
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
-from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
+from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError, JammedError
 from discsim.events import KIND_NAMES, Event
 from discsim.model import Box, Discs
 from discsim.scene import Scene
@@ -186,9 +186,9 @@ class EventDriven(Engine):
         log = self._log if self._logging else None
         try:
             if until != INF:
-                return self._backend.advance(until, limit, log)
+                return self._chunked(until, limit, log)
             return self._advance_open(limit, log)
-        except Interrupted:  # Ctrl-C, deferred to the end of a whole event: the state is consistent
+        except (Interrupted, JammedError):  # raised between two whole events: the state is consistent
             raise
         except BaseException as exc:  # half-way through an event: the state cannot be trusted
             self._broken = f"{type(exc).__name__} at time {self.time!r}"
@@ -210,7 +210,7 @@ class EventDriven(Engine):
         budget = 64 + 16 * len(self.discs)
         while True:
             crossings = backend.counts()["cell_crossings"]
-            k = backend.advance(INF, None if limit is None else limit - done, log, budget)
+            k = self._chunked(INF, None if limit is None else limit - done, log, budget)
             done += k
             if done == limit or backend.counts()["cell_crossings"] - crossings < budget:
                 return done  # the event limit, or nothing left in the queue
@@ -219,6 +219,80 @@ class EventDriven(Engine):
                     self.time = backend.last_event()[0] if done else start
                     return done
                 budget *= 2
+
+    #: A run raises :class:`~discsim.errors.JammedError` after ``jam_events + jam_events_per_disc * N``
+    #: physical events in a row at one instant: far more than a finite cascade of simultaneous collisions
+    #: (``N (N - 1) / 2`` at most for a touching row), while wedged discs collide there for ever.
+    jam_events: int = 10_000
+    jam_events_per_disc: int = 100
+    _jam_mark: tuple[float, int] | None = None  # (time, physical events) when the clock was last seen there
+
+    def _chunked(self, until: float, limit: int | None, log, crossings: int | None = None) -> int:
+        """``backend.advance(until, limit, log, crossings)`` in chunks, watching the clock between them.
+
+        The same result as one call (chunks change nothing in the dynamics), for every backend. Each chunk
+        holds at most the jam threshold of physical events; when that many pass, over any number of calls
+        (a driver's chunks, ``step()`` after ``step()``), with the clock standing still, the discs are jammed.
+
+        Raises:
+            JammedError: naming the jammed discs; the engine is consistent at its last whole event.
+        """
+        backend = self._backend
+        chunk = self.jam_events + self.jam_events_per_disc * len(self.discs)
+        done, left = 0, crossings
+        while True:
+            ask = chunk if limit is None else min(chunk, limit - done)
+            if self._jam_mark is None or self._jam_mark[0] != backend.time:
+                self._jam_mark = (backend.time, self._units())
+            crossed = backend.counts()["cell_crossings"] if crossings is not None else 0
+            k = backend.advance(until, ask, log, left)
+            done += k
+            units = self._units()
+            if backend.time != self._jam_mark[0]:
+                self._jam_mark = (backend.time, units)
+            elif units - self._jam_mark[1] >= chunk:
+                raise JammedError(self._jam_message(units - self._jam_mark[1]))
+            if k < ask or done == limit:
+                return done  # the time or event limit, an empty queue, or the crossings asked for
+            if left is not None:
+                left -= backend.counts()["cell_crossings"] - crossed
+                if left <= 0:
+                    return done
+
+    def _jammed_discs(self) -> np.ndarray:
+        """The discs of the last event and every disc touching them, transitively (sorted, caller's numbering).
+
+        Touching: centres within the contact distance plus 1e-9 of it, minimum image, collision filter obeyed.
+        """
+        last = self._backend.last_event()
+        if last is None:
+            return np.zeros(0, dtype=np.int64)
+        seeds = [d for d in last[2:] if d >= 0]
+        n = len(self.discs)
+        radii = self.discs.radii
+        i, j, d = neighbour_pairs(self.positions, 2.0 * float(radii.max()), self.box)
+        touch = np.hypot(d[:, 0], d[:, 1]) <= (radii[i] + radii[j]) * (1.0 + 1e-9)
+        if self.scene.filtering:
+            touch &= ~self.scene.passes(i, j)
+        i, j = i[touch], j[touch]
+        jammed = np.zeros(n, dtype=bool)
+        jammed[seeds] = True
+        while True:  # grow the touching cluster around the last event's discs
+            grown = jammed.copy()
+            grown[j[jammed[i]]] = True
+            grown[i[jammed[j]]] = True
+            if grown.sum() == jammed.sum():
+                return np.flatnonzero(jammed)
+            jammed = grown
+
+    def _jam_message(self, events: int) -> str:
+        discs = self._jammed_discs().tolist()
+        named = ", ".join(map(str, discs[:20])) + (f", ... ({len(discs)} discs)" if len(discs) > 20 else "")
+        return (
+            f"discs {named} are jammed at time {self.time!r}: wedged against each other or a wall, they made "
+            f"{events} collisions and wall hits without the clock moving; give them room (a gap) or velocities "
+            "that part them"
+        )
 
     def _never_again(self) -> bool:
         """True if, from now on, no pair of discs can ever meet and no disc hits a wall or segment.

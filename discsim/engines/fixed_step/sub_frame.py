@@ -36,7 +36,7 @@ import numpy as np
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BroadPhase
 from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
-from discsim.errors import InvalidArgumentError
+from discsim.errors import InvalidArgumentError, JammedError
 from discsim.events import Event, EventKind
 from discsim.kernels import (
     closest_point_on_segment,
@@ -127,10 +127,21 @@ class SubFrame:
         self.width, self.height = box.width, box.height
 
     # --- the frame ---------------------------------------------------------------------------------------
+    #: A frame with more responses than this, plus this many per disc, raises JammedError: discs wedged
+    #: against each other (an exactly touching lattice, say) would otherwise answer contacts for ever.
+    MAX_RESPONSES = 1000
+    MAX_RESPONSES_PER_DISC = 50
+
     def run(self) -> list[Event]:
-        """Do the frame; return its events."""
+        """Do the frame; return its events.
+
+        Raises:
+            JammedError: after more than ``MAX_RESPONSES + MAX_RESPONSES_PER_DISC * N`` responses in the frame.
+        """
         self.policy.detect(self)
         heap, version, done = self.heap, self.version, self.done
+        cap = self.MAX_RESPONSES + self.MAX_RESPONSES_PER_DISC * len(self.paths.velocities)
+        answered = 0
         while heap:
             tc, _, kind, a, b, stamp_a, stamp_b = heapq.heappop(heap)
             if version.get(a, 0) != stamp_a or (kind == COLLISION and version.get(b, 0) != stamp_b):
@@ -140,6 +151,14 @@ class SubFrame:
                 # wall and a segment, say) would be sent back and forth between them for ever.
                 continue
             done[(kind, a, b)] = tc
+            answered += 1
+            if answered > cap:
+                partner = f"disc {b}" if kind == COLLISION else "a wall or segment"
+                msg = (
+                    f"disc {a} and {partner} are jammed at time {tc!r}: this frame answered more than {cap} "
+                    "contacts; give the discs room (a gap), or use a shorter frame"
+                )
+                raise JammedError(msg)
             if kind == COLLISION:
                 self._collide(tc, a, b)
             elif kind == WALL:

@@ -28,6 +28,8 @@ __all__ = ["build_parser", "main"]
 
 #: Folder the demo writes to unless ``--out`` says otherwise.
 DEFAULT_DEMO_DIR = "discsim-demo"
+#: The demo's figure of all four cases, one row each.
+DEMO_GRID_FILE = "study_cases.png"
 
 
 # --- demo ------------------------------------------------------------------------------------------------
@@ -41,7 +43,7 @@ def _add_demo_parser(subparsers) -> None:
             "Run the four cases of the collision-detection study (missed collision, wrong direction, "
             "multiple collisions, delay) with the exact event-driven engine (PIC) and the fixed-step "
             "engine (PIT) at each case's frame rate; print one comparison row per case; write one "
-            "PNG per case and a GIF of the multiple-collisions case."
+            f"PNG per case, all four in one figure ({DEMO_GRID_FILE}) and a GIF of the multiple-collisions case."
         ),
     )
     parser.add_argument(
@@ -116,7 +118,7 @@ def _run_demo(args) -> int:
     except OSError as exc:
         print(f"discsim demo: cannot create the output folder {str(out)!r}: {exc}", file=sys.stderr)
         return 1
-    rows, written = [], []
+    rows, written, grid = [], [], []
     gif_runs = None
     for number, case in enumerate(ds.study_cases(), start=1):
         pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
@@ -125,12 +127,16 @@ def _run_demo(args) -> int:
         rows.append((case.name, case.frame_rate, report))
         fig = plot.plot_case(pic, pit, title=f"Case {number}, {case.name}: {case.description}")
         written.append(plot.save_figure(fig, out / f"case{number}_{case.name}.png"))
+        grid.append((pic, pit, f"Case {number}, {case.name}: {_failure(report)}"))
         if case.name == "multiple_collisions":
             gif_runs = (number, case, pit, pic)
+    fig = plot.plot_cases(grid)
+    fig.suptitle(f"The study's four cases: PIT ({args.policy}, left) against PIC (exact, right)", fontsize=12)
+    written.append(plot.save_figure(fig, out / DEMO_GRID_FILE))
     if gif_runs is not None and not args.no_gif:
         number, case, pit, pic = gif_runs
         path = out / f"case{number}_{case.name}.gif"
-        anim = plot.animate([pit, pic], path, fps=4, title=f"Case {number}: {case.name} (PIT left, PIC right)")
+        anim = plot.animate([pit, pic], path, fps=12, title=f"Case {number}: {case.name} (PIT left, PIC right)")
         plot.close(anim)
         written.append(path)
     print(f"The collision-detection study's four cases, PIT ({args.policy}) against PIC (exact):\n")

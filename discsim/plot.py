@@ -28,7 +28,7 @@ from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION
 from discsim.model import Discs
 
-__all__ = ["animate", "close", "plot_case", "plot_state", "plot_trajectories", "save_figure"]
+__all__ = ["animate", "close", "plot_case", "plot_cases", "plot_state", "plot_trajectories", "save_figure"]
 
 _OBSTACLE = "0.55"
 
@@ -218,31 +218,68 @@ def _frame_times(truth, approx, max_frames: int) -> np.ndarray:
     return times
 
 
-def _case_limits(frames_list, radii, box):
-    """Axis limits ``(x0, x1, y0, y1)`` around every drawn disc, within the box (plus a margin)."""
+def _case_limits(frames_list, radii, box, *, min_aspect: float = 0.35):
+    """Axis limits ``(x0, x1, y0, y1)`` around every drawn disc, within the box (plus a margin).
+
+    Neither side is shorter than ``min_aspect`` times the other (when the box allows): a case whose
+    discs move along a line is not drawn as a flat strip.
+    """
     points = np.concatenate([f.reshape(-1, 2) for f in frames_list])
     margin = 1.5 * float(radii.max())
     pad = 0.02 * max(box.width, box.height)
-    x0 = max(-pad, float(points[:, 0].min()) - margin)
-    x1 = min(box.width + pad, float(points[:, 0].max()) + margin)
-    y0 = max(-pad, float(points[:, 1].min()) - margin)
-    y1 = min(box.height + pad, float(points[:, 1].max()) + margin)
-    return x0, x1, y0, y1
+    lo = np.maximum(-pad, points.min(axis=0) - margin)
+    hi = np.minimum(np.array([box.width, box.height]) + pad, points.max(axis=0) + margin)
+    bounds = (np.array([-pad, -pad]), np.array([box.width + pad, box.height + pad]))
+    for axis in (0, 1):
+        need = min_aspect * float(hi[1 - axis] - lo[1 - axis]) - float(hi[axis] - lo[axis])
+        if need > 0:  # grow this side about its centre, shifted back inside the box
+            lo[axis] -= need / 2
+            hi[axis] += need / 2
+            shift = max(0.0, bounds[0][axis] - lo[axis]) - max(0.0, hi[axis] - bounds[1][axis])
+            lo[axis] = max(bounds[0][axis], lo[axis] + shift)
+            hi[axis] = min(bounds[1][axis], hi[axis] + shift)
+    return float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1])
+
+
+def _frame_labels(frames, discs, limits) -> list[tuple[float, float, str]]:
+    """Frame numbers to write on the discs, ``(x, y, text)``, none overlapping another.
+
+    A disc that stays in place (within a third of its radius) over several frames gets one label for
+    them all (``"2-5"``); a label that would overlap one already placed (earlier frames first) is left
+    out. Fixed obstacles get none. Label sizes are estimated from the axes' span (7-point text on a
+    panel about 5 inches wide).
+    """
+    span = max(limits[1] - limits[0], limits[3] - limits[2])
+    char, height = 0.014 * span, 0.045 * span  # one character's width and a line's height, in data units
+    candidates = []
+    for i in range(len(discs)):
+        if np.isinf(discs.masses[i]):
+            continue
+        rest = float(discs.radii[i]) / 3.0
+        first = 0
+        for k in range(1, len(frames) + 1):
+            if k == len(frames) or np.hypot(*(frames[k][i] - frames[first][i])) > rest:
+                text = str(first) if k - 1 == first else f"{first}-{k - 1}"
+                candidates.append((first, float(frames[first][i][0]), float(frames[first][i][1]), text))
+                first = k
+    placed: list[tuple[float, float, str]] = []
+    for _, x, y, text in sorted(candidates, key=lambda c: c[0]):
+        half = char * (len(text) + 1) / 2
+        if all(abs(x - px) >= half + char * (len(pt) + 1) / 2 or abs(y - py) >= height for px, py, pt in placed):
+            placed.append((x, y, text))
+    return placed
 
 
 def _draw_case_panel(ax, sim, truth, frames, times, arrow_time, contact_style, title, limits):
     discs = sim.discs
     colours = _disc_colours(discs.masses)
     n = len(discs)
-    label = len(times) <= 25 and n <= 12
     for k, positions in enumerate(frames):
         alpha = 0.12 + 0.43 * k / max(1, len(frames) - 1)
         _circles(ax, positions, discs.radii, colours, alpha=alpha, linewidth=0.6)
-        if label:
-            for i in range(n):
-                if k > 0 and not np.isinf(discs.masses[i]) and np.allclose(positions[i], frames[k - 1][i]):
-                    continue  # a disc at rest: label its first frame only
-                ax.text(*positions[i], str(k), ha="center", va="center", fontsize=6, color="0.15", zorder=5)
+    if len(times) <= 25 and n <= 12:
+        for x, y, text in _frame_labels(frames, discs, limits):
+            ax.text(x, y, text, ha="center", va="center", fontsize=7, color="0.1", zorder=5)
     # Exact contacts (the truth's collisions) as unfilled outlines.
     ev = truth.events
     ev = ev[(ev["kind"] == COLLISION) & (ev["time"] <= times[-1])]
@@ -273,11 +310,39 @@ def _draw_case_panel(ax, sim, truth, frames, times, arrow_time, contact_style, t
     ax.set_title(title, fontsize=10)
 
 
-def plot_case(truth, approx, *, title: str | None = None, max_frames: int = 40):
+_CASE_LEGEND = (
+    Line2D([], [], color="0.3", linestyle="-", linewidth=1.6, label="exact contact (PIC)"),
+    Line2D([], [], color="0.3", linestyle="--", linewidth=1.6, label="exact contact, for reference"),
+    Line2D([], [], color="0.3", marker=r"$\rightarrow$", linestyle="none", markersize=12, label="velocity after"),
+)
+
+
+def _case_frames(truth, approx, max_frames: int):
+    """Frame times, PIT's and PIC's positions at them, the frame interval and the axis limits of a case."""
+    times = _frame_times(truth, approx, max_frames)
+    dt = float(getattr(approx, "dt", 0.0) or 0.0) or (times[-1] - times[0]) / 10.0
+    frames_pit, frames_pic = approx.trajectory(times), truth.trajectory(times)
+    limits = _case_limits([frames_pit, frames_pic], truth.discs.radii, truth.box)
+    return times, frames_pit, frames_pic, dt, limits
+
+
+def _two_axes(ax):
+    try:
+        axes = list(np.ravel(np.asarray(ax, dtype=object)))
+    except TypeError:
+        axes = [ax]
+    if len(axes) != 2 or not all(hasattr(a, "add_patch") for a in axes):
+        msg = f"plot_case(ax=...) takes two matplotlib axes (PIT's, PIC's), got {ax!r}"
+        raise InvalidArgumentError(msg)
+    return axes
+
+
+def plot_case(truth, approx, *, ax=None, title: str | None = None, max_frames: int = 40):
     """PIT and PIC side by side, drawn like the study's figures.
 
-    Each panel shows the discs at every frame time (fainter earlier, frame
-    numbers on small cases), zoomed to where the discs go, the exact contacts of the truth as unfilled
+    Each panel shows the discs at every frame time (fainter earlier; frame
+    numbers on small cases, one label for the frames a disc spends in one place, none stacked), zoomed to
+    where the discs go (never flatter than about 1:3), the exact contacts of the truth as unfilled
     outlines (solid on the PIC panel, dashed on the PIT panel, for reference)
     and each disc's velocity after each of that run's collisions as an arrow
     (drawn as the path covered in two frames).
@@ -286,11 +351,16 @@ def plot_case(truth, approx, *, title: str | None = None, max_frames: int = 40):
         truth: the exact run (PIC), drawn on the right.
         approx: the fixed-step run (PIT), drawn on the left; its ``dt`` sets
             the frame times.
-        title: figure title.
+        ax: two matplotlib axes ``(PIT's, PIC's)`` to draw on, e.g. a row of a grid (see
+            :func:`plot_cases`); None makes a new figure with a legend.
+        title: title of the figure (or of the subfigure holding ``ax``).
         max_frames: at most this many frame times are drawn (evenly thinned).
 
     Returns:
-        The matplotlib ``Figure``.
+        The matplotlib ``Figure`` (the one holding ``ax`` when given).
+
+    Raises:
+        InvalidArgumentError: if ``ax`` is not two axes.
 
     Example:
         >>> import discsim as ds
@@ -302,12 +372,15 @@ def plot_case(truth, approx, *, title: str | None = None, max_frames: int = 40):
         2
         >>> close(fig)
     """
-    times = _frame_times(truth, approx, max_frames)
-    dt = float(getattr(approx, "dt", 0.0) or 0.0) or (times[-1] - times[0]) / 10.0
-    frames_pit, frames_pic = approx.trajectory(times), truth.trajectory(times)
-    limits = _case_limits([frames_pit, frames_pic], truth.discs.radii, truth.box)
-    aspect = (limits[3] - limits[2]) / (limits[1] - limits[0])
-    fig, (ax_pit, ax_pic) = plt.subplots(1, 2, figsize=(11.0, min(9.0, max(3.0, 5.5 * aspect + 1.2))))
+    own = ax is None
+    if not own:
+        ax_pit, ax_pic = _two_axes(ax)
+    times, frames_pit, frames_pic, dt, limits = _case_frames(truth, approx, max_frames)
+    if own:
+        aspect = (limits[3] - limits[2]) / (limits[1] - limits[0])
+        fig, (ax_pit, ax_pic) = plt.subplots(1, 2, figsize=(11.0, min(9.0, max(3.0, 5.5 * aspect + 1.2))))
+    else:
+        fig = ax_pit.figure
     rate = f", {1.0 / dt:.3g} frames per unit time" if dt > 0 else ""
     _draw_case_panel(
         ax_pit, approx, truth, frames_pit, times, 2.0 * dt, "--", f"PIT ({type(approx).__name__}{rate})", limits
@@ -315,43 +388,118 @@ def plot_case(truth, approx, *, title: str | None = None, max_frames: int = 40):
     _draw_case_panel(
         ax_pic, truth, truth, frames_pic, times, 2.0 * dt, "-", f"PIC ({type(truth).__name__}), the truth", limits
     )
-    handles = [
-        Line2D([], [], color="0.3", linestyle="-", linewidth=1.6, label="exact contact (PIC)"),
-        Line2D([], [], color="0.3", linestyle="--", linewidth=1.6, label="exact contact, for reference"),
-        Line2D([], [], color="0.3", marker=r"$\rightarrow$", linestyle="none", markersize=12, label="velocity after"),
-    ]
-    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8, frameon=False)
     if title:
         fig.suptitle(textwrap.fill(title, 110), fontsize=11)
-    fig.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
+    if own:
+        fig.legend(handles=list(_CASE_LEGEND), loc="lower center", ncol=3, fontsize=8, frameon=False)
+        fig.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
     return fig
 
 
-def _animation_times(sims, max_frames: int) -> np.ndarray:
+def plot_cases(cases, *, width: float = 11.0, max_frames: int = 40):
+    """Several PIT-against-PIC cases in one figure: one row per case, PIT left, PIC right.
+
+    Each row is a subfigure drawn by :func:`plot_case` with its title above it; rows are as tall as
+    their cases need.
+
+    Args:
+        cases: a sequence of ``(truth, approx, title)``: the exact run (PIC), the fixed-step run (PIT)
+            and the row's title (or None).
+        width: figure width in inches.
+        max_frames: at most this many frame times per case.
+
+    Returns:
+        The matplotlib ``Figure``.
+
+    Example:
+        >>> import discsim as ds
+        >>> rows = []
+        >>> for case in ds.study_cases()[:2]:
+        ...     pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
+        ...     pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate).run(until=case.until)
+        ...     rows.append((pic, pit, case.name))
+        >>> fig = plot_cases(rows)
+        >>> len(fig.axes), len(fig.subfigs)
+        (4, 2)
+        >>> close(fig)
+    """
+    cases = list(cases)
+    if not cases:
+        msg = "plot_cases() needs at least one (truth, approx, title)"
+        raise InvalidArgumentError(msg)
+    heights = []
+    for truth, approx, _ in cases:
+        limits = _case_frames(truth, approx, max_frames)[-1]
+        aspect = (limits[3] - limits[2]) / (limits[1] - limits[0])
+        heights.append(min(0.9 * width, max(0.25 * width, 0.5 * width * aspect)) * 0.9 + 0.7)
+    fig = plt.figure(figsize=(width, sum(heights) + 0.4), layout="constrained")
+    rows = fig.subfigures(len(cases), 1, height_ratios=heights, squeeze=False)[:, 0]
+    for row, (truth, approx, title) in zip(rows, cases, strict=True):
+        plot_case(truth, approx, ax=row.subplots(1, 2), title=title, max_frames=max_frames)
+    fig.legend(handles=list(_CASE_LEGEND), loc="outside lower center", ncol=3, fontsize=8, frameon=False)
+    return fig
+
+
+#: Frames a default animation aims at: a run with a frame interval gets sub-frames in between.
+_ANIMATION_FRAMES = 60
+
+
+def _animation_times(sims, max_frames: int) -> tuple[np.ndarray, float]:
+    """Frame times of an animation and the frame interval of the runs (0 when none has one).
+
+    With a frame interval ``dt`` (a PIT run), every frame time of that run is a movie frame, with evenly
+    spaced sub-frames in between so that the motion reads (about ``_ANIMATION_FRAMES`` in all).
+    """
     start = max(float(s.start_time) for s in sims)
     end = min(float(s.time) for s in sims)
     dt = max(float(getattr(s, "dt", 0.0) or 0.0) for s in sims)
     if dt > 0:
         count = math.floor((end - start) / dt * (1 + 1e-12) + 1e-9)
-        times = np.minimum(start + dt * np.arange(count + 1), end)
+        sub = max(1, min(math.ceil(_ANIMATION_FRAMES / max(1, count)), max(1, (max_frames - 1) // max(1, count))))
+        times = np.minimum(start + dt * (np.arange(count * sub + 1) / sub), end)
     else:
-        times = np.linspace(start, end, 61)
+        times = np.linspace(start, end, _ANIMATION_FRAMES + 1)
     if len(times) > max_frames:
         times = times[np.linspace(0, len(times) - 1, max_frames).round().astype(int)]
-    return times
+    return times, dt
+
+
+def _contact_outlines(ax, truth, colours, linestyle):
+    """Unfilled outlines of ``truth``'s collisions (hidden; shown from their time on): ``[(time, patch)]``."""
+    ev = truth.events
+    ev = ev[ev["kind"] == COLLISION][:40]
+    out = []
+    for rec in ev:
+        for d, x, y in ((int(rec["i"]), rec["xi"], rec["yi"]), (int(rec["j"]), rec["xj"], rec["yj"])):
+            patch = Circle(
+                (float(x), float(y)),
+                float(truth.discs.radii[d]),
+                fill=False,
+                edgecolor=colours[d],
+                linestyle=linestyle,
+                linewidth=1.6,
+                zorder=3,
+                visible=False,
+            )
+            ax.add_patch(patch)
+            out.append((float(rec["time"]), patch))
+    return out
 
 
 def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max_frames: int = 200, title=None):
     """Animate one run, or several side by side, from their event logs.
+
+    The time is written inside the first panel (with the frame number on a PIT frame time), and the
+    collisions of the event-driven runs are outlined from their time on (solid on their own panel,
+    dashed on the others, as in :func:`plot_case`).
 
     Args:
         sim: an engine, or a sequence of engines over the same box (e.g.
             ``[pit, pic]``), each built with ``record=True``.
         path: where to save: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
             None saves nothing.
-        times: the frame times ``(T,)``; default the frame times of the run
-            with the largest ``dt`` (or 61 evenly spaced times), at most
-            ``max_frames`` of them.
+        times: the frame times ``(T,)``; default about 60 evenly spaced times, which include every
+            frame time of the run with the largest ``dt``; at most ``max_frames`` of them.
         fps: frames per second of the movie.
         dpi: resolution of a saved movie.
         max_frames: cap on the default number of frames.
@@ -384,12 +532,16 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
         if suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
             msg = f"cannot write {str(path)!r}: MP4 needs ffmpeg, which was not found; save a .gif instead"
             raise RuntimeError(msg)
-    times = _animation_times(sims, max_frames) if times is None else np.atleast_1d(np.asarray(times, dtype=float))
+    if times is None:
+        times, dt = _animation_times(sims, max_frames)
+    else:
+        times, dt = np.atleast_1d(np.asarray(times, dtype=float)), 0.0
     box = sims[0].box
     aspect = box.height / box.width
     width = 4.5 * len(sims)
     fig, axes = plt.subplots(1, len(sims), figsize=(width, max(2.5, 4.5 * aspect + 0.8)), squeeze=False)
-    panels = []
+    truths = [s for s in sims if type(s).__name__ == "EventDriven"]
+    panels, outlines = [], []
     for ax, s in zip(axes[0], sims, strict=True):
         paths = s.trajectory(times)
         colours = _disc_colours(s.discs.masses)
@@ -399,12 +551,26 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
         ]
         for c in circles:
             ax.add_patch(c)
+        if len(sims) > 1:
+            for truth in truths:
+                outlines += _contact_outlines(ax, truth, colours, "-" if truth is s else "--")
         _setup(ax, s.box)
         ax.set_title(type(s).__name__, fontsize=10)
         panels.append((paths, circles))
-    clock = fig.text(0.01, 0.01, "", fontsize=9)
+    clock = axes[0][0].text(
+        0.02,
+        0.98,
+        "",
+        transform=axes[0][0].transAxes,
+        ha="left",
+        va="top",
+        fontsize=9,
+        zorder=6,
+        bbox={"boxstyle": "round,pad=0.2", "facecolor": "white", "edgecolor": "0.7", "alpha": 0.85},
+    )
     if title:
         fig.suptitle(title)
+    fig.tight_layout()
 
     def update(k):
         changed = [clock]
@@ -412,7 +578,11 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
             for i, c in enumerate(circles):
                 c.set_center(tuple(paths[k, i]))
             changed.extend(circles)
-        clock.set_text(f"t = {times[k]:.3f}")
+        for t, patch in outlines:
+            patch.set_visible(t <= times[k])
+        frame = (times[k] - times[0]) / dt if dt > 0 else math.nan
+        on_frame = dt > 0 and abs(frame - round(frame)) < 1e-9
+        clock.set_text(f"t = {times[k]:.3f}" + (f"  (PIT frame {round(frame)})" if on_frame else ""))
         return changed
 
     update(0)

@@ -29,9 +29,11 @@ def test_demo_prints_the_table_and_writes_the_figures(tmp_path, capsys):
     assert "missed 1 collision" in rows[2]
     assert "late by 0.0629" in rows[3]
     pngs = sorted(p.name for p in out.glob("*.png"))
-    assert pngs == [f"case{k}_{name}.png" for k, name in enumerate(CASES, start=1)]
+    assert pngs == [f"case{k}_{name}.png" for k, name in enumerate(CASES, start=1)] + [cli.DEMO_GRID_FILE]
     gifs = list(out.glob("*.gif"))
     assert [g.name for g in gifs] == ["case3_multiple_collisions.gif"]
+    with Image.open(gifs[0]) as gif:
+        assert gif.n_frames == 65  # PIT's 9 frame times (0 to 1.6 every 0.2) and 7 sub-frames between two
     for path in [*out.glob("*.png"), *gifs]:
         with Image.open(path) as image:
             assert np.asarray(image.convert("RGB"), dtype=float).std() > 0
@@ -41,7 +43,7 @@ def test_demo_prints_the_table_and_writes_the_figures(tmp_path, capsys):
 def test_demo_without_gif_and_with_another_policy(tmp_path, capsys):
     assert cli.main(["demo", "--out", str(tmp_path), "--no-gif", "--policy", "revert"]) == 0
     assert "PIT (revert)" in capsys.readouterr().out
-    assert len(list(tmp_path.glob("*.png"))) == 4 and not list(tmp_path.glob("*.gif"))
+    assert len(list(tmp_path.glob("*.png"))) == 5 and not list(tmp_path.glob("*.gif"))
 
 
 def test_usage_errors(capsys, tmp_path):

@@ -105,7 +105,16 @@ def test_animate_saves_a_gif_of_two_runs(tmp_path):
     assert isinstance(anim, animation.FuncAnimation)
     assert_not_blank(path)
     with Image.open(path) as gif:
-        assert gif.n_frames == 13  # one per PIT frame, 0 to 2.4 every 0.2
+        assert gif.n_frames == 61  # each PIT frame (0 to 2.4 every 0.2) and 4 sub-frames between two
+    # The clock is inside the first panel, and names the PIT frame on a frame time.
+    fig = anim._fig
+    (clock,) = [t for t in fig.axes[0].texts if t.get_text().startswith("t = ")]
+    assert clock.get_transform() == fig.axes[0].transAxes and 0 <= min(clock.get_position()) <= 1
+    assert clock.get_text() == "t = 2.400  (PIT frame 12)"  # the last frame drawn
+    # PIC's collision is outlined on both panels once it has happened (solid on PIC's, dashed on PIT's).
+    outlines = [[p for p in ax.patches if isinstance(p, Circle) and not p.get_fill()] for ax in fig.axes]
+    assert [len(o) for o in outlines] == [2, 2] and all(p.get_visible() for o in outlines for p in o)
+    assert {p.get_linestyle() for p in outlines[0]} == {"--"} and {p.get_linestyle() for p in outlines[1]} == {"-"}
     plot.close(anim)
 
 
@@ -118,3 +127,44 @@ def test_animate_refuses_what_it_cannot_write(tmp_path):
         with pytest.raises(RuntimeError, match="ffmpeg"):
             plot.animate(sim, tmp_path / "movie.mp4")
     assert not any(tmp_path.iterdir())  # nothing half-written
+
+
+def test_plot_case_draws_into_given_axes_and_plot_cases_makes_one_grid(tmp_path):
+    rows = []
+    for case in ds.study_cases():
+        pic, pit = case_runs(case)
+        rows.append((pic, pit, case.name))
+    fig, axes = plt.subplots(2, 2)
+    assert plot.plot_case(rows[2][0], rows[2][1], ax=axes[1]) is fig
+    assert axes[1][0].get_title().startswith("PIT") and axes[1][1].get_title().startswith("PIC")
+    assert not axes[0][0].has_data() and not fig.legends  # the other axes untouched, no figure legend
+    with pytest.raises(ds.InvalidArgumentError, match="two matplotlib axes"):
+        plot.plot_case(rows[2][0], rows[2][1], ax=axes[0][0])
+    grid = plot.plot_cases(rows)
+    assert len(grid.subfigs) == 4 and len(grid.axes) == 8
+    assert [sub._suptitle.get_text() for sub in grid.subfigs] == [name for *_, name in rows]
+    assert_not_blank(plot.save_figure(grid, tmp_path / "cases.png"))
+    with pytest.raises(ds.InvalidArgumentError, match="at least one"):
+        plot.plot_cases([])
+
+
+def test_case_figures_are_readable_zoomed_and_never_stack_labels():
+    case = ds.scenarios.missed_collision()
+    pic, pit = case_runs(case)
+    fig = plot.plot_case(pic, pit)
+    for ax in fig.axes:
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        assert (y1 - y0) / (x1 - x0) >= 0.35 - 1e-9  # not a flat strip
+        places = np.array([t.get_position() for t in ax.texts])
+        assert len(places) >= 4
+        gaps = np.hypot(*(places[:, None, :] - places[None, :, :]).transpose(2, 0, 1))
+        assert gaps[np.triu_indices(len(places), 1)].min() > 0.3  # no two labels on one spot
+    # The near-static disc of case 1 gets one label for the frames it spends in place.
+    assert any("-" in t.get_text() for t in fig.axes[0].texts)
+    # Fixed obstacles (case 3's grey disc) get no frame labels at all.
+    case = ds.scenarios.multiple_collisions()
+    pic, pit = case_runs(case)
+    fig = plot.plot_case(pic, pit)
+    obstacle = pic.discs.positions[np.isinf(pic.discs.masses)][0]
+    for ax in fig.axes:
+        assert all(np.hypot(*(np.array(t.get_position()) - obstacle)) > 0.5 for t in ax.texts)

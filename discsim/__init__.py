@@ -15,8 +15,11 @@ The public API::
 
 from discsim import scenarios
 from discsim.analysis.compare import Comparison, compare
-from discsim.analysis.theory import enskog_collision_rate, henderson_z, speed_cdf, speed_pdf
-from discsim.analysis.thermo import compressibility_factor
+from discsim.analysis.dynamics import free_times, msd, vacf
+from discsim.analysis.frames import Frames, frames
+from discsim.analysis.structure import psi6, rdf
+from discsim.analysis.theory import enskog_collision_rate, enskog_diffusion, henderson_z, speed_cdf, speed_pdf
+from discsim.analysis.thermo import compressibility_factor, thermo
 from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import POLICIES, FixedStep, FixedStepState
 from discsim.errors import (
@@ -35,9 +38,12 @@ from discsim.errors import (
 )
 from discsim.events import EVENT_DTYPE, Event, EventKind
 from discsim.io.checkpoints import checkpoint_info, load, resume
+from discsim.io.gsd import read_gsd, write_gsd
 from discsim.io.streams import StreamedEvents, read_events, trajectory_from_events
+from discsim.io.xyz import read_xyz, write_xyz
 from discsim.model import Box, Discs, Segment, polygon
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
+from discsim.run.samplers import GSDWriter, Sampler
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
 from discsim.view import View, view  # cheap (no matplotlib); binds ds.view to the function, not the module
 
@@ -72,6 +78,8 @@ __all__ = [
     "EventStream",
     "FixedStep",
     "FixedStepState",
+    "Frames",
+    "GSDWriter",
     "Interrupted",
     "InvalidArgumentError",
     "InvalidDiscsError",
@@ -81,6 +89,7 @@ __all__ = [
     "OverlapError",
     "PackingError",
     "ProgressBar",
+    "Sampler",
     "Scenario",
     "Segment",
     "StreamedEvents",
@@ -92,18 +101,30 @@ __all__ = [
     "compare",
     "compressibility_factor",
     "enskog_collision_rate",
+    "enskog_diffusion",
+    "frames",
+    "free_times",
     "head_on",
     "henderson_z",
     "load",
+    "msd",
     "newtons_cradle",
     "polygon",
+    "psi6",
     "random_gas",
+    "rdf",
     "read_events",
+    "read_gsd",
+    "read_xyz",
     "resume",
     "scenarios",
     "speed_cdf",
     "speed_pdf",
     "study_cases",
+    "thermo",
     "trajectory_from_events",
+    "vacf",
     "view",
+    "write_gsd",
+    "write_xyz",
 ]

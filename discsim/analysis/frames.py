@@ -1,0 +1,220 @@
+"""Frames: the exact state of every disc at chosen sample times, the input of every analysis.
+
+A :class:`Frames` holds positions (wrapped and unwrapped) and velocities at ``T`` sample times, with the box
+and the discs' radii, masses and groups. It comes from a finished run (:func:`frames`, rebuilt exactly from
+the event log), from a run as it goes (:class:`discsim.Sampler`, which samples every ``dt`` of simulated
+time and needs no log), or from a file (:func:`discsim.read_gsd`, :func:`discsim.read_xyz`). The analyses
+(:func:`discsim.rdf`, :func:`discsim.psi6`, :func:`discsim.msd`, :func:`discsim.vacf`) take its arrays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from discsim.errors import InvalidArgumentError
+from discsim.model import Box, Discs
+from discsim.trajectory import check_times, reconstruct
+
+__all__ = ["Frames", "frames", "log_source", "states_at"]
+
+
+@dataclass(frozen=True)
+class Frames:
+    """The discs at ``T`` sample times.
+
+    Attributes:
+        times: ``(T,)`` simulated times.
+        positions: ``(T, N, 2)`` centres, wrapped into a periodic box.
+        unwrapped: ``(T, N, 2)`` centres followed across the periodic edges (equal to ``positions`` with
+            walls), continuous from the run's start: what a mean-squared displacement needs.
+        velocities: ``(T, N, 2)`` velocities.
+        box: the box.
+        radii, masses: ``(N,)``; groups: ``(N,)`` integer group labels.
+    """
+
+    times: np.ndarray
+    positions: np.ndarray
+    unwrapped: np.ndarray
+    velocities: np.ndarray
+    box: Box
+    radii: np.ndarray
+    masses: np.ndarray
+    groups: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.times)
+
+    @property
+    def n(self) -> int:
+        """Number of discs."""
+        return len(self.radii)
+
+    def discs(self, k: int = -1) -> Discs:
+        """Frame ``k`` as :class:`~discsim.model.Discs` (to start a new engine from it)."""
+        return Discs(self.positions[k], self.velocities[k], self.radii, self.masses, self.groups)
+
+    @classmethod
+    def from_discs(cls, discs: Discs, box: Box, time: float = 0.0, unwrapped=None) -> Frames:
+        """One frame of ``discs`` in ``box`` at ``time``; ``unwrapped`` ``(N, 2)`` (default the positions)."""
+        pos = np.asarray(discs.positions, dtype=float)[None].copy()
+        vel = np.asarray(discs.velocities, dtype=float)[None].copy()
+        unwrapped = pos if unwrapped is None else np.asarray(unwrapped, dtype=float)[None].copy()
+        return cls(
+            np.array([float(time)]),
+            box.wrap(pos),
+            unwrapped,
+            vel,
+            box,
+            np.array(discs.radii, dtype=float),
+            np.array(discs.masses, dtype=float),
+            np.array(discs.groups),
+        )
+
+    @classmethod
+    def concatenate(cls, parts: list[Frames]) -> Frames:
+        """The frames of ``parts`` (same discs and box) one after the other."""
+        if not parts:
+            msg = "Frames.concatenate needs at least one Frames"
+            raise InvalidArgumentError(msg)
+        first = parts[0]
+        return cls(
+            np.concatenate([p.times for p in parts]),
+            np.concatenate([p.positions for p in parts]),
+            np.concatenate([p.unwrapped for p in parts]),
+            np.concatenate([p.velocities for p in parts]),
+            first.box,
+            first.radii,
+            first.masses,
+            first.groups,
+        )
+
+
+def states_at(events: np.ndarray, positions0, velocities0, time0: float, times, box: Box):
+    """Exact unwrapped positions and velocities ``(T, N, 2)`` each at ``times`` from a state and a log.
+
+    Positions come from :func:`discsim.trajectory.reconstruct` (``unwrapped=True``), so they are those of
+    ``sim.trajectory(times, unwrapped=True)``; velocities are each disc's last recorded velocity at or
+    before each time (an event exactly at a sample time counts as done, as for positions).
+
+    Args:
+        events: structured array of :data:`~discsim.events.EVENT_DTYPE` in time order, after ``time0``.
+        positions0, velocities0: ``(N, 2)`` state at ``time0`` (positions unwrapped or not).
+        time0: when the state holds. times: ``(T,)`` times at or after ``time0``.
+        box: the box.
+    """
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    positions0 = np.asarray(positions0, dtype=float)
+    velocities0 = np.asarray(velocities0, dtype=float)
+    unwrapped = reconstruct(events, positions0, velocities0, time0, times, box, unwrapped=True)
+    n = len(positions0)
+    disc, t_rec, seq, vel = [np.arange(n)], [np.full(n, float(time0))], [np.full(n, -1)], [velocities0]
+    if len(events):
+        disc.append(events["i"])
+        t_rec.append(events["time"])
+        seq.append(np.arange(len(events)))
+        vel.append(np.column_stack([events["vxi"], events["vyi"]]))
+        pair = np.flatnonzero(events["j"] >= 0)
+        disc.append(events["j"][pair])
+        t_rec.append(events["time"][pair])
+        seq.append(pair)
+        vel.append(np.column_stack([events["vxj"][pair], events["vyj"][pair]]))
+    disc, t_rec, seq, vel = np.concatenate(disc), np.concatenate(t_rec), np.concatenate(seq), np.vstack(vel)
+    order = np.lexsort((seq, t_rec, disc))  # by disc, then time, then log order (as reconstruct)
+    t_rec, vel = t_rec[order], vel[order]
+    starts = np.searchsorted(disc[order], np.arange(n))
+    velocities = np.empty((len(times), n, 2))
+    for k, t in enumerate(times.tolist()):
+        # A disc's records are in time order, so those at or before t are a prefix of its run of records.
+        done = np.add.reduceat((t_rec <= t).astype(np.int64), starts)
+        velocities[k] = vel[starts + np.maximum(done, 1) - 1]
+    return unwrapped, velocities
+
+
+def log_source(source, what: str):
+    """``(events chunks, discs at start, box, start_time, end_time, engine or None)`` of a finished run.
+
+    ``source`` is an engine holding its log (``record=True``), an engine whose log was streamed to disk
+    (read back chunk by chunk), a :class:`~discsim.io.streams.StreamedEvents`, or the path of a streamed log.
+    ``events chunks`` is a function returning an iterator of structured arrays in time order.
+
+    Raises:
+        InvalidArgumentError: if the run recorded nothing (``record=False`` and no stream), naming ``what``.
+    """
+    from discsim.io.container import iter_stream
+    from discsim.io.streams import StreamedEvents, read_events
+
+    if isinstance(source, (str, Path)):
+        source = read_events(source)
+    if isinstance(source, StreamedEvents):
+        log = source
+        return (lambda: iter([log.events])), log.discs, log.box, log.start_time, log.end_time, None
+    if not hasattr(source, "_log") or not hasattr(source, "discs"):
+        msg = f"{what} needs an engine, a streamed event log or its path, got {type(source).__name__}"
+        raise InvalidArgumentError(msg)
+    sim = source
+    if sim._stream is not None:
+        path = sim._stream["path"]
+        header = next(iter_stream(path, partial=True))
+        meta, arrays = header[0], header[1]
+        discs = Discs(arrays["positions"], arrays["velocities"], arrays["radii"], arrays["masses"], arrays["groups"])
+        start = float(meta["start_time"])
+
+        def chunks():
+            walk = iter_stream(path, partial=True)
+            next(walk)
+            for _meta, _arrays, records, _end in walk:
+                yield records
+
+        return chunks, discs, sim.box, start, sim.time, sim
+    if not sim.record:
+        msg = (
+            f"{what} needs the run's event log, and this {type(sim).__name__} ran with record=False, recording "
+            "nothing: build it with record=True, stream the log (run(record_to=...)), or sample during the run "
+            "with ds.Sampler(dt)"
+        )
+        raise InvalidArgumentError(msg)
+    return (lambda: iter([sim._log.to_array()])), sim.discs, sim.box, sim.start_time, sim.time, sim
+
+
+def frames(source, times) -> Frames:
+    """The exact state of every disc at ``times``, rebuilt from a finished run's event log.
+
+    Args:
+        source: an engine that recorded its log (``record=True``), or streamed it (``run(record_to=...)``),
+            a :class:`~discsim.io.streams.StreamedEvents` or the path of a streamed log.
+        times: ``(T,)`` simulated times within the run's span, any order (frames come in that order).
+
+    Returns:
+        :class:`Frames`: ``positions`` equal ``sim.trajectory(times)`` (to roundoff at the periodic edges),
+        ``unwrapped`` equal ``sim.trajectory(times, unwrapped=True)``, and the velocities at those times.
+
+    Raises:
+        InvalidArgumentError: if the run recorded nothing (``record=False``): sample during the run with
+            :class:`discsim.Sampler` instead.
+        TimeError: if a time is not finite or lies outside the run's span.
+
+    Example:
+        >>> import discsim as ds
+        >>> sim = ds.EventDriven(*ds.random_gas(50, 0.3, seed=1)).run(until=2.0)
+        >>> f = ds.frames(sim, [0.0, 1.0, 2.0])
+        >>> f.positions.shape, bool(np.allclose(f.velocities[-1], sim.velocities))
+        ((3, 50, 2), True)
+    """
+    chunks, discs, box, start, end, _ = log_source(source, "frames()")
+    times = check_times(times, start, end, "simulated span")
+    parts = list(chunks())
+    events = np.concatenate(parts) if len(parts) > 1 else parts[0]
+    unwrapped, velocities = states_at(events, discs.positions, discs.velocities, start, times, box)
+    return Frames(
+        times,
+        box.wrap(unwrapped),
+        unwrapped,
+        velocities,
+        box,
+        np.array(discs.radii, dtype=float),
+        np.array(discs.masses, dtype=float),
+        np.array(discs.groups),
+    )

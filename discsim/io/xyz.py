@@ -1,0 +1,218 @@
+"""Extended XYZ files (ASE's conventions): a plain-text fallback that ASE, OVITO and many tools read.
+
+Each frame is a count line, a comment line of ``key=value`` pairs, and one line per disc (the comment line
+is one line in the file; it is cut here)::
+
+    1
+    Lattice="10.0 0.0 0.0 0.0 8.0 0.0 0.0 0.0 0.0"
+        Properties=species:S:1:pos:R:3:radius:R:1:velo:R:3:mass:R:1:group:I:1 pbc="T T F" Time=0.5
+    H 1.0 2.0 0.0 0.5 0.1 -0.2 0.0 1.0 0
+
+- ``Lattice``: the cell vectors ``(W, 0, 0), (0, H, 0), (0, 0, 0)`` (a 2D cell: zero third vector); discsim's box
+  ``[0, W] x [0, H]`` is the cell itself (no shift: XYZ cells start at the origin).
+- ``pbc="T T F"`` for a periodic box, ``"F F F"`` for walls. ``Time``: the simulated time.
+- Columns: ``species`` (an element symbol per group, ``H``, ``He``, ``Li``, ... in the order of the sorted
+  group labels, so that ASE can build its ``Atoms``; the label itself is the ``group`` column), ``pos``
+  (z = 0), ``radius``, ``velo`` (z = 0), ``mass`` (``inf`` for an obstacle) and ``group``.
+
+Numbers are written with ``repr`` (17 significant digits), so a file reads back exactly. Unwrapped positions
+are not stored: a file read back has ``unwrapped`` equal to ``positions``.
+"""
+
+from __future__ import annotations
+
+import shlex
+from pathlib import Path
+
+import numpy as np
+
+from discsim.analysis.frames import Frames
+from discsim.errors import InvalidArgumentError
+from discsim.model import Box
+
+__all__ = ["read_xyz", "write_xyz"]
+
+#: Placeholder species for the groups, so that ASE can build Atoms (the group label is its own column).
+SYMBOLS = "H He Li Be B C N O F Ne Na Mg Al Si P S Cl Ar K Ca Sc Ti V Cr Mn Fe Co Ni Cu Zn Ga Ge As Se Br Kr".split()
+PROPERTIES = "species:S:1:pos:R:3:radius:R:1:velo:R:3:mass:R:1:group:I:1"
+
+
+def write_xyz(path, source, times=None) -> Path:
+    """Write discs to an extended XYZ file (created, or replaced), one XYZ frame per time.
+
+    Args:
+        path: the file.
+        source: a :class:`~discsim.analysis.frames.Frames`, or an engine: its state now, or at ``times``.
+        times: with an engine, the simulated times to write (rebuilt from its event log).
+
+    Returns:
+        The path written.
+
+    Raises:
+        InvalidArgumentError: on another source, or more groups than placeholder species (36).
+
+    Example:
+        >>> import os, tempfile, discsim as ds
+        >>> sim = ds.EventDriven(*ds.random_gas(20, 0.3, seed=1)).run(until=1.0)
+        >>> path = ds.write_xyz(os.path.join(tempfile.mkdtemp(), "gas.xyz"), sim, times=[0.0, 1.0])
+        >>> back = ds.read_xyz(path)
+        >>> bool((back.positions == ds.frames(sim, [0.0, 1.0]).positions).all()), back.box == sim.box
+        (True, True)
+    """
+    from discsim.io.gsd import _as_frames
+
+    frames = _as_frames(source, times)
+    labels = np.unique(frames.groups)
+    if len(labels) > len(SYMBOLS):
+        msg = f"write_xyz names at most {len(SYMBOLS)} groups with species, got {len(labels)}"
+        raise InvalidArgumentError(msg)
+    species = [SYMBOLS[k] for k in np.searchsorted(labels, frames.groups).tolist()]
+    box = frames.box
+    lattice = f"{box.width!r} 0.0 0.0 0.0 {box.height!r} 0.0 0.0 0.0 0.0"
+    pbc = "T T F" if box.periodic else "F F F"
+    radii = frames.radii.tolist()
+    masses = frames.masses.tolist()
+    groups = frames.groups.tolist()
+    lines = []
+    for k in range(len(frames)):
+        lines.append(str(frames.n))
+        lines.append(f'Lattice="{lattice}" Properties={PROPERTIES} pbc="{pbc}" Time={float(frames.times[k])!r}')
+        pos, vel = frames.positions[k].tolist(), frames.velocities[k].tolist()
+        for d in range(frames.n):
+            lines.append(
+                f"{species[d]} {pos[d][0]!r} {pos[d][1]!r} 0.0 {radii[d]!r} {vel[d][0]!r} {vel[d][1]!r} 0.0 "
+                f"{masses[d]!r} {groups[d]}"
+            )
+    path = Path(path)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _parse_comment(line: str, path, frame: int) -> dict:
+    try:
+        words = shlex.split(line)
+    except ValueError as exc:
+        msg = f"{path}: frame {frame}'s comment line is not key=value pairs ({exc})"
+        raise InvalidArgumentError(msg) from exc
+    out = {}
+    for word in words:
+        key, sep, value = word.partition("=")
+        if sep:
+            out[key.lower()] = value
+    return out
+
+
+def read_xyz(path) -> Frames:
+    """Read an extended XYZ file of discs (as :func:`write_xyz` writes) as Frames.
+
+    Needs ``Lattice`` (a rectangle in the xy plane) and ``Properties`` with ``pos``; ``radius`` (default 0.5),
+    ``velo`` (default 0), ``mass`` (default 1) and ``group`` (default: the species, numbered in sorted order)
+    are read when present. ``pbc`` decides the box (default periodic).
+
+    Raises:
+        FileNotFoundError: if there is no such file.
+        InvalidArgumentError: if the file is not extended XYZ as above, holds 3D data (a nonzero z, or a
+            cell with a third vector), or its frames differ in the number of discs or the box.
+    """
+    path = Path(path)
+    if not path.is_file():
+        msg = f"no XYZ file at {str(path)!r}"
+        raise FileNotFoundError(msg)
+    lines = path.read_text().splitlines()
+    at, frame = 0, 0
+    times, positions, velocities = [], [], []
+    box = radii = masses = groups = None
+    while at < len(lines):
+        if not lines[at].strip():
+            at += 1
+            continue
+        try:
+            n = int(lines[at])
+        except ValueError as exc:
+            msg = f"{path}: line {at + 1} should count the discs of frame {frame}, got {lines[at][:40]!r}"
+            raise InvalidArgumentError(msg) from exc
+        if at + 2 + n > len(lines):
+            msg = f"{path}: frame {frame} announces {n} discs but the file ends first"
+            raise InvalidArgumentError(msg)
+        info = _parse_comment(lines[at + 1], path, frame)
+        frame_box = _box(info, path, frame)
+        columns = _columns(info, path, frame)
+        rows = [lines[at + 2 + d].split() for d in range(n)]
+        width = sum(count for _, _, count in columns)
+        if any(len(row) != width for row in rows):
+            msg = f"{path}: frame {frame} has lines without the {width} columns its Properties name"
+            raise InvalidArgumentError(msg)
+        table = {}
+        start = 0
+        for name, kind, count in columns:
+            values = [row[start : start + count] for row in rows]
+            if kind != "S":
+                try:
+                    values = np.array(values, dtype=float)
+                except ValueError as exc:
+                    msg = f"{path}: frame {frame}: column {name} holds values that are not numbers"
+                    raise InvalidArgumentError(msg) from exc
+            table[name] = values
+            start += count
+        if "pos" not in table:
+            msg = f"{path}: frame {frame}'s Properties hold no pos column"
+            raise InvalidArgumentError(msg)
+        pos = table["pos"]
+        if pos.shape[1] > 2 and np.any(pos[:, 2] != 0.0):
+            msg = f"{path} holds 3D data: frame {frame} has discs off the plane z = 0"
+            raise InvalidArgumentError(msg)
+        if box is None:
+            box = frame_box
+            radii = table["radius"][:, 0] if "radius" in table else np.full(n, 0.5)
+            masses = table["mass"][:, 0] if "mass" in table else np.ones(n)
+            if "group" in table:
+                groups = table["group"][:, 0].astype(np.int64)
+            elif "species" in table:
+                names = [v[0] for v in table["species"]]
+                groups = np.unique(names, return_inverse=True)[1].reshape(-1)
+            else:
+                groups = np.zeros(n, dtype=np.int64)
+        elif frame_box != box or n != len(radii):
+            msg = f"{path}: frame {frame} differs from frame 0 in its box or its number of discs"
+            raise InvalidArgumentError(msg)
+        times.append(float(info.get("time", frame)))
+        positions.append(box.wrap(pos[:, :2]))
+        velocities.append(table["velo"][:, :2] if "velo" in table else np.zeros((n, 2)))
+        at += 2 + n
+        frame += 1
+    if box is None:
+        msg = f"{path} holds no frame"
+        raise InvalidArgumentError(msg)
+    positions = np.array(positions)
+    return Frames(np.array(times), positions, positions.copy(), np.array(velocities), box, radii, masses, groups)
+
+
+def _box(info: dict, path, frame: int) -> Box:
+    if "lattice" not in info:
+        msg = f'{path}: frame {frame} has no Lattice="..." (not extended XYZ, or no cell)'
+        raise InvalidArgumentError(msg)
+    try:
+        cell = np.array(info["lattice"].split(), dtype=float).reshape(3, 3)
+    except ValueError as exc:
+        msg = f"{path}: frame {frame}'s Lattice is not 9 numbers: {info['lattice']!r}"
+        raise InvalidArgumentError(msg) from exc
+    if cell[2].any() or cell[0, 1:].any() or cell[1, [0, 2]].any():
+        msg = (
+            f"{path}: frame {frame}'s Lattice {info['lattice']!r} is not a 2D rectangle "
+            "(W 0 0  0 H 0  0 0 0): 3D data or a tilted cell"
+        )
+        raise InvalidArgumentError(msg)
+    pbc = info.get("pbc", "T T F").split()
+    return Box(float(cell[0, 0]), float(cell[1, 1]), periodic=bool(pbc) and pbc[0].upper().startswith("T"))
+
+
+def _columns(info: dict, path, frame: int) -> list[tuple[str, str, int]]:
+    spec = info.get("properties", "species:S:1:pos:R:3").split(":")
+    if len(spec) % 3:
+        msg = f"{path}: frame {frame}'s Properties {':'.join(spec)!r} are not name:type:count triples"
+        raise InvalidArgumentError(msg)
+    try:
+        return [(spec[k].lower(), spec[k + 1].upper(), int(spec[k + 2])) for k in range(0, len(spec), 3)]
+    except ValueError as exc:
+        msg = f"{path}: frame {frame}'s Properties have a count that is not an integer"
+        raise InvalidArgumentError(msg) from exc

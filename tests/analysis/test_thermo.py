@@ -1,0 +1,104 @@
+"""thermo(): the virial from the log equals the engine's own, block averages with since=, and bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import discsim as ds
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_from_the_start_equals_the_engine_pressure(periodic):
+    sim = ds.EventDriven(*ds.random_gas(300, 0.45, periodic=periodic, seed=2)).run(until=5.0)
+    t = ds.thermo(sim)
+    assert t.pressure == pytest.approx(sim.pressure(), rel=1e-12)
+    assert t.z == pytest.approx(ds.compressibility_factor(sim), rel=1e-12)
+    assert t.collisions == sim.counts["collisions"]
+    assert t.collision_rate == pytest.approx(2 * sim.counts["collisions"] / (300 * 5.0))
+    assert t.since == 0.0 and t.until == 5.0 and t.blocks == 10 and t.method == "batch means"
+    assert len(t.z_blocks) == 10 and np.allclose(np.diff(t.edges), 0.5)
+
+
+def test_obstacles_and_unequal_masses():
+    discs, box = ds.random_gas(200, 0.3, seed=4)
+    masses = np.where(np.arange(200) % 3 == 0, 2.5, 1.0)
+    masses[5] = np.inf
+    velocities = np.array(discs.velocities)
+    velocities[5] = 0.0
+    discs = ds.Discs(discs.positions, velocities, discs.radii, masses)
+    sim = ds.EventDriven(discs, box).run(until=4.0)
+    assert ds.thermo(sim).pressure == pytest.approx(sim.pressure(), rel=1e-12)
+    assert ds.thermo(sim).n == 199
+
+
+def test_since_skips_the_melting_and_meets_henderson():
+    sim = ds.EventDriven(*ds.random_gas(1000, 0.5, seed=0)).run(until=20.0)
+    late = ds.thermo(sim, since=4.0, blocks=8)
+    assert late.since == 4.0 and late.blocks == 8
+    assert abs(late.z - ds.henderson_z(0.5)) < 4 * late.z_err + 0.01 * ds.henderson_z(0.5)
+    assert late.z_err > 0 and late.collision_rate_err > 0
+    assert late.collision_rate == pytest.approx(float(ds.enskog_collision_rate(0.5)), rel=0.03)
+    assert "batch means over 8 blocks" in str(late)
+
+
+def test_a_streamed_log_is_read_chunk_by_chunk(tmp_path):
+    discs, box = ds.random_gas(200, 0.4, seed=6)
+    memory = ds.EventDriven(discs, box).run(until=6.0)
+    streamed = ds.EventDriven(discs, box, record=False)
+    streamed.stream_chunk = 500  # many chunks on disk
+    streamed.run(until=6.0, record_to=tmp_path / "events.dse")
+    a, b = ds.thermo(memory, since=1.5), ds.thermo(streamed, since=1.5)
+    assert b.z == pytest.approx(a.z, rel=1e-12) and b.z_err == pytest.approx(a.z_err, rel=1e-9)
+    c = ds.thermo(tmp_path / "events.dse", since=1.5)
+    assert c.z == pytest.approx(a.z, rel=1e-12)
+
+
+def test_a_sampler_gathers_the_same_virial():
+    discs, box = ds.random_gas(300, 0.4, seed=1)
+    sim = ds.EventDriven(discs, box).run(until=5.0)
+    sampler = ds.Sampler(0.5)
+    ds.EventDriven(discs, box, record=False).run(until=5.0, observers=[sampler])
+    a, b = ds.thermo(sim, since=1.0), ds.thermo(sampler, since=1.0)
+    assert b.z == pytest.approx(a.z, rel=1e-12) and b.collisions == a.collisions
+    assert ds.thermo(sampler).pressure == pytest.approx(sim.pressure(), rel=1e-12)
+    rounded = ds.thermo(sampler, since=1.01)  # up to the next block of dt / 8
+    assert rounded.since == pytest.approx(1.0625)
+
+
+@pytest.mark.parametrize("since", [-1.0, 5.0, 7.0, float("nan"), "2"])
+def test_since_outside_the_run_is_refused(since):
+    sim = ds.EventDriven(*ds.random_gas(50, 0.3, seed=1)).run(until=5.0)
+    with pytest.raises(ds.TimeError, match="since"):
+        ds.thermo(sim, since=since)
+    with pytest.raises(ds.TimeError, match="since"):
+        ds.compressibility_factor(sim, since=since)
+
+
+def test_bad_sources_and_blocks():
+    sim = ds.EventDriven(*ds.random_gas(50, 0.3, seed=1), record=False).run(until=2.0)
+    with pytest.raises(ds.InvalidArgumentError, match="record=False"):
+        ds.thermo(sim)
+    with pytest.raises(ds.InvalidArgumentError, match="record=False"):
+        ds.compressibility_factor(sim, since=1.0)
+    assert ds.compressibility_factor(sim) > 1  # from the start needs no log
+    with pytest.raises(ds.InvalidArgumentError, match="blocks"):
+        ds.thermo(sim, blocks=1)
+    case = ds.scenarios.head_on(1.0, 1.0)
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=30).run(until=1.0)
+    with pytest.raises(ds.InvalidArgumentError, match="pressure"):
+        ds.thermo(pit)
+    with pytest.raises(ds.InvalidArgumentError, match="not observed"):
+        ds.thermo(ds.Sampler(1.0))
+    short = ds.Sampler(1.0)
+    ds.EventDriven(*ds.random_gas(50, 0.3, seed=1), record=False).run(until=1.0, observers=[short])
+    with pytest.raises(ds.InvalidArgumentError, match="fewer than blocks"):
+        ds.thermo(short, blocks=10)
+
+
+def test_plot_returns_axes():
+    import matplotlib.pyplot as plt
+
+    sim = ds.EventDriven(*ds.random_gas(100, 0.3, seed=1)).run(until=3.0)
+    assert ds.thermo(sim).plot() is not None
+    plt.close("all")

@@ -69,6 +69,9 @@ def test_run_writes_its_files_and_prints_a_summary(tmp_path, capsys):
     assert summary["pressure"] == same.pressure()
     assert summary["henderson_Z"] == pytest.approx(2.8333, abs=1e-4)
     assert 0.8 < summary["Z"] / summary["henderson_Z"] < 1.2
+    assert summary["since"] == 2.0 and summary["Z_err"] > 0  # a fifth of --until, with a batch-means error
+    assert abs(summary["Z"] - summary["henderson_Z"]) < 4 * summary["Z_err"] + 0.03
+    assert summary["Z_from_start"] == pytest.approx(same.pressure() * box.area / same.kinetic_energy())
     assert summary["events_on_disk"] == len(ds.read_events(out / RUN_FILES["events"]).events)
     assert 89.0 < summary["bytes_per_event"] < 100.0  # 89 per event plus the header (the initial discs)
     assert ds.checkpoint_info(out / RUN_FILES["checkpoint"])["run"]["finished"]

@@ -35,6 +35,7 @@ from discsim.errors import (
     PackingError,
     TimeError,
     UnitsError,
+    WrongTypeError,
 )
 from discsim.events import EVENT_DTYPE, Event, EventKind
 from discsim.io.checkpoints import checkpoint_info, load, resume
@@ -96,6 +97,7 @@ __all__ = [
     "TimeError",
     "UnitsError",
     "View",
+    "WrongTypeError",
     "billiard_break",
     "checkpoint_info",
     "compare",

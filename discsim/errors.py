@@ -20,6 +20,7 @@ __all__ = [
     "PackingError",
     "TimeError",
     "UnitsError",
+    "WrongTypeError",
 ]
 
 
@@ -29,6 +30,10 @@ class DiscsimError(Exception):
 
 class InvalidArgumentError(DiscsimError, ValueError):
     """An argument out of its range: a run limit, a step, an option's name, a scene parameter."""
+
+
+class WrongTypeError(InvalidArgumentError, TypeError):
+    """An argument of the wrong type (a tuple where a Segment belongs, a list where Discs do); also a TypeError."""
 
 
 class InvalidDiscsError(DiscsimError, ValueError):

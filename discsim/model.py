@@ -12,12 +12,59 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from discsim.errors import InvalidDiscsError
+from discsim.errors import InvalidArgumentError, InvalidDiscsError, UnitsError
 
-__all__ = ["Box", "Discs", "Segment", "kinetic_energy", "momentum", "normalize_pass_through", "polygon"]
+__all__ = [
+    "LENGTH_RANGE",
+    "MASS_RANGE",
+    "RESOLUTION",
+    "SPEED_RANGE",
+    "Box",
+    "Discs",
+    "Segment",
+    "kinetic_energy",
+    "momentum",
+    "normalize_pass_through",
+    "polygon",
+]
 
 #: Relative tolerance on the contact distance below which two discs count as overlapping.
 OVERLAP_TOLERANCE = 1e-9
+
+# The supported units (issue 18, part 3). The time of impact squares lengths, speeds and length times
+# speed (``|dr|^2``, ``|dv|^2``, ``(dr . dv)^2``, ``|dv|^2 |dr|^2``); each must stay a normal float
+# (2.2e-308 to 1.8e308) with room to spare, or discs pass through each other unseen. Lengths and speeds
+# within 1e-50 to 1e50 keep every such square and product within 1e-232 to 1e200, and times of impact
+# (length / speed) within 1e-100 to 1e100; masses within 1e-100 to 1e100 keep energies and impulses
+# (mass times speed squared) within 1e-200 to 1e200. Everything in SI units lies well inside.
+#: Radii, box sides and |position| (length units): each within this range (positions may also be 0).
+LENGTH_RANGE = (1e-50, 1e50)
+#: The speed |v| of each moving disc (length per time unit): 0, or within this range.
+SPEED_RANGE = (1e-50, 1e50)
+#: Each finite mass (mass units); ``numpy.inf`` (an obstacle) is allowed too.
+MASS_RANGE = (1e-100, 1e100)
+#: The smallest radius must be at least this fraction of the box's longer side: positions near the far
+#: side are resolved to 2.2e-16 of the box, and the contact geometry to about 1e-6 of a radius then.
+RESOLUTION = 1e-10
+
+
+def _check_range(what: str, values: np.ndarray, name: str, zero: bool = False, upper_only: bool = False) -> None:
+    """Raise :class:`UnitsError` naming the first disc whose ``values`` lie outside the range ``name``.
+
+    ``zero``: 0 is allowed too. ``upper_only``: only the upper bound applies.
+    """
+    lo, hi = globals()[name]
+    bad = values > hi
+    if not upper_only:
+        bad |= (values < lo) & ((values != 0.0) if zero else True)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        span = f"at most {hi:g}" if upper_only else f"[{lo:g}, {hi:g}]" + (" or 0" if zero else "")
+        msg = (
+            f"disc {i} has {what} {float(values[i])!r}, outside the range discsim supports ({span}; "
+            f"discsim.model.{name}): express it in other units"
+        )
+        raise UnitsError(msg)
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
@@ -95,6 +142,10 @@ class Discs:
             i = _first_bad(bad)
             msg = f"disc {i} has mass {float(mass[i])!r}; masses must be positive (numpy.inf for an obstacle)"
             raise InvalidDiscsError(msg)
+        _check_range("radius", rad, "LENGTH_RANGE")
+        _check_range("coordinate", np.abs(pos).max(axis=1) if n else np.zeros(0), "LENGTH_RANGE", upper_only=True)
+        _check_range("speed", np.hypot(vel[:, 0], vel[:, 1]), "SPEED_RANGE", zero=True)
+        _check_range("mass", np.where(np.isinf(mass), 1.0, mass), "MASS_RANGE")
         moving_obstacle = np.isinf(mass) & (vel != 0).any(axis=1)
         if moving_obstacle.any():
             i = _first_bad(moving_obstacle)
@@ -177,21 +228,27 @@ class Box:
 
     def __post_init__(self):
         for name in ("width", "height"):
-            value = getattr(self, name)
-            try:
-                value = float(value)
-            except (TypeError, ValueError) as exc:
-                msg = f"box {name} must be a number, got {value!r}"
-                raise InvalidDiscsError(msg) from exc
+            given = getattr(self, name)
+            if isinstance(given, (bool, np.bool_)) or not isinstance(given, (int, float, np.integer, np.floating)):
+                msg = f"box {name} must be a number, got {given!r}"  # float("10") would take a string
+                raise InvalidArgumentError(msg)
+            value = float(given)
             if not (math.isfinite(value) and value > 0):
-                msg = f"box {name} must be positive and finite, got {value!r}"
-                raise InvalidDiscsError(msg)
+                msg = f"box {name} must be positive and finite, got {given!r}"
+                raise InvalidArgumentError(msg)
+            lo, hi = LENGTH_RANGE
+            if not lo <= value <= hi:
+                msg = (
+                    f"box {name} {value!r} is outside the supported lengths [{lo:g}, {hi:g}] "
+                    "(discsim.model.LENGTH_RANGE): express it in other units"
+                )
+                raise UnitsError(msg)
             object.__setattr__(self, name, value)
         flag = self.periodic
         if not (isinstance(flag, (bool, np.bool_)) or (isinstance(flag, (int, np.integer)) and flag in (0, 1))):
             # bool("no") would be True
             msg = f"box periodic must be True or False, got {self.periodic!r}"
-            raise InvalidDiscsError(msg)
+            raise InvalidArgumentError(msg)
         object.__setattr__(self, "periodic", bool(self.periodic))
 
     def as_dict(self) -> dict:

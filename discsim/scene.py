@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from discsim.cells import neighbour_pairs
-from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError
-from discsim.model import OVERLAP_TOLERANCE, Box, Discs, Segment, normalize_pass_through
+from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
+from discsim.model import OVERLAP_TOLERANCE, RESOLUTION, Box, Discs, Segment, normalize_pass_through
 
 __all__ = ["Scene", "check_fits", "check_scene", "filter_table"]
 
@@ -94,21 +94,57 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
         ``(segments, pass_through)`` as a tuple of segments and a frozenset of sorted group pairs.
 
     Raises:
-        TypeError: if a segment is not a :class:`~discsim.model.Segment`.
+        WrongTypeError: if a segment is not a :class:`~discsim.model.Segment`.
+        UnitsError: if the smallest radius is below ``RESOLUTION`` of the box's longer side.
         ValueError: if segments are given with a periodic box.
         OutsideBoxError, OverlapError: from :func:`check_fits`.
     """
     segments = tuple(segments)
     for k, segment in enumerate(segments):
         if not isinstance(segment, Segment):
-            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__}"
-            raise TypeError(msg)
+            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__} {segment!r}"
+            raise WrongTypeError(msg)
     if segments and box.periodic:
         msg = "segments need a box with walls (periodic=False)"
         raise InvalidArgumentError(msg)
+    for k, segment in enumerate(segments):
+        if not _crosses_box(segment, box):
+            msg = f"segments[{k}] {segment!r} lies entirely outside the box {box.width:g} x {box.height:g}"
+            raise InvalidArgumentError(msg)
+    if len(discs):
+        smallest, longest = float(discs.radii.min()), max(box.width, box.height)
+        if smallest < RESOLUTION * longest:
+            i = int(np.argmin(discs.radii))
+            msg = (
+                f"disc {i} has radius {smallest!r}, below {RESOLUTION:g} of the box's longer side {longest!r}: "
+                "positions near the far side would not resolve its contacts (discsim.model.RESOLUTION)"
+            )
+            raise UnitsError(msg)
     pass_through = normalize_pass_through(pass_through)
     check_fits(discs, box, segments=segments, pass_through=pass_through)
     return segments, pass_through
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _crosses_box(segment: Segment, box: Box) -> bool:
+    """True if ``segment`` meets the box's rectangle (its ends may both lie outside)."""
+    p0, p1 = segment.p0, segment.p1
+    lo, hi = 0.0, 1.0  # Liang-Barsky clipping of p0 + s (p1 - p0), s in [0, 1]
+    for axis, size in ((0, box.width), (1, box.height)):
+        d = p1[axis] - p0[axis]
+        for q, e in ((p0[axis], -d), (size - p0[axis], d)):
+            if e == 0.0:
+                if q < 0.0:
+                    return False
+            elif e < 0.0:
+                lo = max(lo, q / e)
+            else:
+                hi = min(hi, q / e)
+    return lo <= hi
 
 
 class Scene:
@@ -127,7 +163,7 @@ class Scene:
         blocked ((G, G) bool): True where two groups pass through each other.
 
     Raises:
-        TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
+        WrongTypeError: if ``discs``, ``box`` or a segment is of the wrong type.
         InvalidArgumentError: if segments are given with a periodic box.
         InvalidDiscsError: on a malformed ``pass_through``.
         OutsideBoxError, OverlapError: if the discs do not fit (see :func:`check_fits`).
@@ -142,11 +178,11 @@ class Scene:
 
     def __init__(self, discs: Discs, box: Box, segments=(), pass_through=()):
         if not isinstance(discs, Discs):
-            msg = f"discs must be a discsim.Discs, got {type(discs).__name__}"
-            raise TypeError(msg)
+            msg = f"discs must be a discsim.Discs, got {type(discs).__name__} {_short(discs)}"
+            raise WrongTypeError(msg)
         if not isinstance(box, Box):
-            msg = f"box must be a discsim.Box, got {type(box).__name__}"
-            raise TypeError(msg)
+            msg = f"box must be a discsim.Box, got {type(box).__name__} {_short(box)}"
+            raise WrongTypeError(msg)
         self.segments, self.pass_through = check_scene(discs, box, segments, pass_through)
         self.discs = discs
         self.box = box

@@ -48,7 +48,7 @@ def test_errors_are_value_errors_and_discsim_errors():
 
 @pytest.mark.parametrize(("w", "h"), [(0.0, 1.0), (-2.0, 1.0), (1.0, np.nan), (np.inf, 1.0)])
 def test_bad_box_is_refused(w, h):
-    with pytest.raises(ds.InvalidDiscsError, match="box (width|height)"):
+    with pytest.raises(ds.InvalidArgumentError, match="box (width|height)"):
         ds.Box(w, h)
 
 
@@ -177,7 +177,7 @@ def test_a_box_too_small_for_an_asked_cell_size_names_the_cell_size():
 
 @pytest.mark.parametrize("flag", ["no", "False", None, 2])
 def test_box_periodic_must_be_a_flag(flag):
-    with pytest.raises(ds.InvalidDiscsError, match="periodic must be True or False"):
+    with pytest.raises(ds.InvalidArgumentError, match="periodic must be True or False"):
         ds.Box(10.0, 10.0, periodic=flag)
 
 

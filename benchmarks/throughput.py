@@ -11,7 +11,9 @@ of the main section are interleaved over the points
 (every point once, then again), so that a slow spell of a shared machine does
 not bias the ratios between sizes that the engine issue's targets are about.
 
-The main PIC section times the engine's default event queue (the ``queue``
+The main PIC section and the queue section time the pure-Python backend (``backend="python"``: the one
+with a choice of queues); the backends section (``benchmarks/backends.py``, ``backends.csv``) puts it side
+by side with the compiled backend. The main PIC section times the engine's default event queue (the ``queue``
 column names it: ``calendar`` when this was written). The queue section runs
 ``calendar``, ``sorted`` and ``heap`` side by side at packing fraction 0.3,
 runs interleaved (seed by seed, queue by queue) so that drift in the machine's
@@ -265,10 +267,19 @@ def measure_pic_fresh(n: int, packing_fraction: float, queue: str | None, seed: 
 
 
 def _build(n: int, packing_fraction: float, seed: int, queue: str | None = None) -> ds.EventDriven:
-    """A periodic random gas and its engine; ``queue=None`` leaves the engine's default."""
+    """A periodic random gas and its engine under the Python backend (the one with a choice of queue);
+    ``queue=None`` leaves the engine's default. The compiled backend is timed by :func:`backends_section`."""
     discs, box = ds.random_gas(n, packing_fraction, periodic=True, seed=seed)
     options = {} if queue is None else {"queue": queue}
-    return ds.EventDriven(discs, box, record=False, **options)
+    return ds.EventDriven(discs, box, record=False, backend="python", **options)
+
+
+def backends_section(config: Config, results: Path) -> list[dict]:
+    """The two backends side by side (``benchmarks/backends.py``): writes ``backends.csv``."""
+    import backends
+
+    quick = config.repeats == 1 and max(config.sizes) < 1000
+    return backends.backends_section(backends.QUICK if quick else backends.FULL, config.repeats, results)
 
 
 def summarise(runs: list[dict], n: int, packing_fraction: float) -> dict:
@@ -854,6 +865,7 @@ def plot(throughput_rows: list[dict], queue_rows: list[dict], path: Path) -> Pat
 SECTIONS = [
     (f"PIC throughput (periodic random gas, default queue: {DEFAULT_QUEUE})", pic_throughput_section),
     (f"PIC event queues side by side: {', '.join(QUEUES)}", queue_section),
+    ("PIC backends side by side: python against numba (compiled)", backends_section),
     ("PIT throughput: frames/s and pair tests/s, cell grid against all pairs", pit_throughput_section),
     ("PIC against PIT: seconds per unit simulated time at 1% missed", pic_against_pit_section),
 ]
@@ -883,6 +895,7 @@ def main(argv=None) -> int:
         "throughput_queue.csv",
         "throughput_pit.csv",
         "throughput_crossover.csv",
+        "backends.csv",
     ]
     print(f"wrote {', '.join(str(args.results / f) for f in written)}, {png}, {pit_png}")
     return 0

@@ -269,3 +269,17 @@ def test_time_limit_interrupts_a_long_block():
 
 def test_format_table_docstring_example():
     assert doctest.testmod(benchutils, raise_on_error=False).failed == 0
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
+def test_backends_script_writes_both_backends_side_by_side(tmp_path):
+    done = _run_quick("backends.py", tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = _read_csv(tmp_path / "backends.csv")
+    assert {row["discs"] for row in rows} == {"monodisperse", "1:10 mixture"}
+    for row in rows:
+        assert float(row["python_rate"]) > 0 and float(row["numba_rate"]) > 0
+        assert float(row["speedup"]) == pytest.approx(float(row["numba_rate"]) / float(row["python_rate"]))
+    compile_rows = _read_csv(tmp_path / "backends_compile.csv")
+    assert {row["cache"] for row in compile_rows} == {"cold", "warm"}

@@ -19,6 +19,8 @@ import pytest
 from paths import FIXTURES, GOLDEN
 
 import discsim as ds
+from discsim import _numba
+from discsim.engines.fixed_step.engine import COMPILED_POLICIES
 
 _spec = importlib.util.spec_from_file_location("make_golden", GOLDEN / "make_golden.py")
 make_golden = importlib.util.module_from_spec(_spec)
@@ -58,6 +60,23 @@ def assert_matches(sim, path: Path) -> None:
 def test_golden_log(name):
     engine, build, how = SCENES[name]
     sim = make_golden.run_scene(engine, build, how)
+    assert_matches(sim, GOLDEN / f"{name}.npz")
+
+
+#: The fixed-step scenes whose policy has a compiled frame ("fs_<policy>_<scene>").
+FS_COMPILED = [name for name in SCENES if name.startswith("fs_") and name.split("_")[1] in COMPILED_POLICIES]
+
+
+@pytest.mark.parametrize("backend", ["python", "numba"])
+@pytest.mark.parametrize("name", FS_COMPILED)
+def test_golden_log_of_each_fixed_step_backend(name, backend):
+    """The fixed-step scenes under each backend by name (``test_golden_log`` runs the default, ``"auto"``)."""
+    if backend == "numba" and not _numba.available():
+        pytest.skip("numba is not installed or is hidden (the fast extra)")
+    _, build, (key, value) = SCENES[name]
+    discs, box, kwargs = build()
+    sim = ds.FixedStep(discs, box, backend=backend, **kwargs).run(**{key: value})
+    assert sim.backend == backend
     assert_matches(sim, GOLDEN / f"{name}.npz")
 
 

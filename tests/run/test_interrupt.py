@@ -18,10 +18,11 @@ from discsim import _numba
 ENGINES = {
     "event_driven": lambda: ds.EventDriven(*ds.random_gas(2000, 0.4, seed=1), backend="python"),
     "event_driven-numba": lambda: ds.EventDriven(*ds.random_gas(2000, 0.4, seed=1), backend="numba"),
-    "fixed_step": lambda: ds.FixedStep(*ds.random_gas(2000, 0.4, seed=1), dt=0.001),
+    "fixed_step": lambda: ds.FixedStep(*ds.random_gas(2000, 0.4, seed=1), dt=0.001, backend="python"),
+    "fixed_step-numba": lambda: ds.FixedStep(*ds.random_gas(2000, 0.4, seed=1), dt=0.001, backend="numba"),
 }
-# Long enough that the interrupt, 0.3 s in, falls inside the run (the compiled loop runs ~20x faster).
-UNTIL = {"event_driven": 40.0, "event_driven-numba": 800.0, "fixed_step": 3.0}
+# Long enough that the interrupt, 0.3 s in, falls inside the run (the compiled loops run ~10-20x faster).
+UNTIL = {"event_driven": 40.0, "event_driven-numba": 800.0, "fixed_step": 3.0, "fixed_step-numba": 30.0}
 
 
 def _interrupt_after(seconds: float) -> threading.Timer:

@@ -19,6 +19,10 @@ that pass through each other before the narrow phase, under every policy.
 log and the frame clock, and hands each frame to its policy, which works on the state arrays
 (:class:`~discsim.engines.fixed_step.arrays.Paths`). The run state is exported and loaded as a
 :class:`~discsim.engines.fixed_step.state.FixedStepState`.
+
+Two backends run the frames: ``"python"`` (numpy; the modules above) and ``"numba"`` (the frame policies
+compiled, :mod:`discsim.engines.fixed_step.numba`), which give the same frames bit for bit and the same
+state, so a run saved under one continues under the other.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ import math
 import numpy as np
 
 from discsim._interrupt import deferred_interrupt
+from discsim._numba import resolve_backend
 from discsim._validate import check_count, positive_finite
 from discsim.cells import CellGrid
 from discsim.engines.base import Engine
@@ -41,7 +46,7 @@ from discsim.events import Event
 from discsim.model import Box, Discs
 from discsim.scene import Scene
 
-__all__ = ["BROAD_PHASES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
+__all__ = ["BACKENDS", "BROAD_PHASES", "COMPILED_POLICIES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
 
 _POLICY_CLASSES = {**FRAME_POLICY_CLASSES, **SUB_FRAME_POLICY_CLASSES}
 #: Response policies of :class:`FixedStep`.
@@ -50,6 +55,10 @@ POLICIES = tuple(_POLICY_CLASSES)
 SUB_FRAME_POLICIES = tuple(SUB_FRAME_POLICY_CLASSES)
 #: Broad phases of :class:`FixedStep`.
 BROAD_PHASES = tuple(BROAD_PHASE_CLASSES)
+#: Backends of :class:`FixedStep`'s frame.
+BACKENDS = ("python", "numba")
+#: The policies whose frame the ``"numba"`` backend compiles (the others run in Python under ``"auto"``).
+COMPILED_POLICIES = ("resolve", "revert", "separate")
 
 #: Default frames per unit of time.
 DEFAULT_FRAME_RATE = 30.0
@@ -81,12 +90,17 @@ class FixedStep(Engine):
             :class:`~discsim.engines.event_driven.EventDriven`. Free when empty.
         bisect_tol: the ``"bisect"`` policy's tolerance on contact times (time
             units; default ``1e-6 * dt``).
+        backend: what runs the frames: ``"auto"`` (the default: ``"numba"`` when numba
+            imports and the policy is one of :data:`COMPILED_POLICIES`, else ``"python"``),
+            ``"numba"`` (the frame compiled, from the ``fast`` extra: ``pip install
+            "discsim[fast]"``) or ``"python"`` (numpy). Both give the same frames bit for bit.
 
     Raises:
         InvalidArgumentError: on a frame rate, ``dt`` or ``bisect_tol`` that is
             not a positive finite number, both of ``frame_rate`` and ``dt`` given
-            and disagreeing, an unknown policy or broad phase, or segments in
-            a periodic box.
+            and disagreeing, an unknown policy, broad phase or backend, segments in
+            a periodic box, ``backend="numba"`` without numba (naming the extra to
+            install) or with a policy it does not compile (``"bisect"``, ``"swept"``).
         TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
         InvalidDiscsError: on a malformed ``pass_through``.
         OutsideBoxError, OverlapError: if the discs do not fit in the box (or
@@ -96,6 +110,7 @@ class FixedStep(Engine):
 
     Attributes:
         time (float): the current time; frame ``k`` falls at ``start_time + k * dt``.
+        backend (str): the backend that runs the frames, ``"python"`` or ``"numba"``.
         dt (float): the frame interval. frame_rate (float): ``1 / dt``.
         frames (int): frames done since the start.
         counts (dict[str, int]): ``frames``; ``pair_tests`` (narrow-phase
@@ -145,6 +160,7 @@ class FixedStep(Engine):
         segments=(),
         pass_through=(),
         bisect_tol: float | None = None,
+        backend: str = "auto",
     ):
         if dt is None:
             rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
@@ -164,13 +180,16 @@ class FixedStep(Engine):
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
+        backend = _choose_backend(backend, policy)
         self._configure(
-            Scene(discs, box, segments, pass_through), record, rate, step, by_rate, policy, broad_phase, tol
+            Scene(discs, box, segments, pass_through), record, rate, step, by_rate, policy, broad_phase, tol, backend
         )
         self._load(self._initial_state())
 
-    def _configure(self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol) -> None:
-        """Build the parts the options choose (checked already); the run state comes from :meth:`_load`."""
+    def _configure(self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend) -> None:
+        """Build the parts the options choose (checked already; ``backend`` resolved); the run state comes
+        from :meth:`_load`.
+        """
         super().__init__(scene, record)
         shapes = Shapes(scene)
         # The same box check as EventDriven's cell grid (a periodic box needs 3 cells a side);
@@ -182,9 +201,14 @@ class FixedStep(Engine):
         self.policy = policy
         self.broad_phase = broad_phase
         self.bisect_tol = bisect_tol
+        self.backend = backend
         self._shapes = shapes
         self._broad = BROAD_PHASE_CLASSES[broad_phase](shapes)
-        if policy == "bisect":
+        if backend == "numba":
+            from discsim.engines.fixed_step.numba.policy import CompiledFrame  # numba loads only when asked for
+
+            self._policy = CompiledFrame(policy, shapes, self._broad)
+        elif policy == "bisect":
             self._policy = Bisect(shapes, self._broad, bisect_tol)
         else:
             self._policy = _POLICY_CLASSES[policy](shapes, self._broad)
@@ -245,6 +269,7 @@ class FixedStep(Engine):
             "policy": self.policy,
             "broad_phase": self.broad_phase,
             "bisect_tol": self.bisect_tol,
+            "backend": self.backend,
         }
 
     @classmethod
@@ -253,6 +278,7 @@ class FixedStep(Engine):
         if settings["policy"] not in POLICIES or settings["broad_phase"] not in BROAD_PHASES:
             msg = f"unknown policy {settings['policy']!r} or broad phase {settings['broad_phase']!r}"
             raise CheckpointError(msg)
+        backend = _choose_backend(settings.get("backend", "auto"), settings["policy"])
         sim._configure(
             scene,
             settings["record"],
@@ -262,6 +288,7 @@ class FixedStep(Engine):
             settings["policy"],
             settings["broad_phase"],
             float(settings["bisect_tol"]),
+            backend,
         )
         sim.start_time = start_time
         sim._load(state)
@@ -300,12 +327,17 @@ class FixedStep(Engine):
             msg = "a fixed-step run needs a finite until or a frame count"
             raise InvalidArgumentError(msg)
         done = 0
+        batch = getattr(self._policy, "batch", 1)  # frames per call: the compiled frame does many at once
         while done < todo:
             # Ctrl-C ends the run at a whole frame; a handler of the program's own may let it go on.
             with deferred_interrupt() as interrupted:
                 while done < todo and not interrupted[0]:
-                    self._frame()
-                    done += 1
+                    count = min(batch, todo - done)
+                    if count > 1:
+                        self._frames(count)
+                    else:
+                        self._frame()
+                    done += count
         return todo
 
     def _frames_due(self, until: float) -> float:
@@ -419,6 +451,24 @@ class FixedStep(Engine):
         tally.counts["frames"] = k
         return events
 
+    def _frames(self, count: int) -> None:
+        """Do ``count`` frames in one call of the compiled frame (the same frames as ``count`` calls of
+        :meth:`_frame`; a policy without :meth:`frames` never gets here).
+        """
+        paths, tally = self._paths, self._tally
+        k = tally.counts["frames"]
+        times = self.frame_time(np.arange(k + 1, k + count + 1))
+        tally.log = self._log if self._logging else None
+        try:
+            self._policy.frames(paths, tally, self._frame_time, times)
+        except Interrupted:  # pragma: no cover - raised only between calls (deferred_interrupt)
+            raise
+        except BaseException as exc:  # half-way through the frames: the state cannot be trusted
+            self._broken = f"{type(exc).__name__} in frames {k + 1} to {k + count}"
+            raise
+        self._frame_time = self.time = float(times[-1])
+        tally.counts["frames"] = k + count
+
     @property
     def frames(self) -> int:
         """Frames done since the start."""
@@ -479,3 +529,22 @@ class FixedStep(Engine):
             ([0.0, 0.25, 0.5], 0.6)
         """
         return self.frame_time(np.arange(self.frames + 1))
+
+
+def _choose_backend(backend, policy: str) -> str:
+    """The backend that runs the frames for the argument ``backend`` and ``policy`` (checked already).
+
+    Raises:
+        InvalidArgumentError: an unknown backend, ``"numba"`` without numba, or ``"numba"`` with a
+            policy that has no compiled frame.
+    """
+    chosen = resolve_backend(backend, BACKENDS, "FixedStep")
+    if chosen == "numba" and policy not in COMPILED_POLICIES:
+        if backend == "numba":
+            msg = (
+                f"policy {policy!r} has no compiled frame (backend='numba' compiles {list(COMPILED_POLICIES)}); "
+                "use backend='auto' or 'python'"
+            )
+            raise InvalidArgumentError(msg)
+        return "python"
+    return chosen

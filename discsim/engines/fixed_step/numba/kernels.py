@@ -1,0 +1,662 @@
+"""The frame policies ``resolve``, ``revert`` and ``separate``, compiled: one call does a whole frame.
+
+The algorithm and the order of the floating-point operations are those of
+:mod:`discsim.engines.fixed_step.frame` and :mod:`discsim.engines.fixed_step.broad_phase`, so both
+backends give the same frames bit for bit: the move on the lazy clocks, the wall hits (by disc), the
+segment hits (by disc, then segment), then the overlapping pairs sorted by ``(i, j)``, each pair seeing the
+velocities the pairs before it left. The Verlet list of the ``"grid"`` broad phase is rebuilt in the same
+order as :func:`discsim.cells.neighbour_pairs` gives its pairs, so the exported state is the same too.
+Python's ``math.hypot`` (used by ``"separate"``) is not the C library's ``hypot``: :func:`cpython_hypot`
+is CPython's own algorithm, so the two agree to the last bit.
+
+Every function is ``njit(cache=True)`` (no fastmath: it would reorder the floating-point operations); the
+first process compiles them (seconds) and writes the machine code to ``__pycache__``; later processes load
+it. Without numba the functions stay plain Python: importable (for doctests) and correct, only slow.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from discsim._numba import numba
+
+_nb = numba()
+if _nb is None:  # pragma: no cover - the engine imports this module only when numba imports
+
+    def jit(function):
+        return function
+
+else:
+    # error_model="numpy": no zero check on every division; the frame divides only by numbers it has
+    # tested (or that cannot vanish), as the Python frame does.
+    jit = _nb.njit(cache=True, error_model="numpy")
+
+#: The compiled policies by name: the ``policy`` argument of :func:`frame`.
+POLICY_CODES = {"resolve": 0, "revert": 1, "separate": 2}
+RESOLVE, REVERT, SEPARATE = 0, 1, 2
+INF = math.inf
+_DBL_MIN = 2.2250738585072014e-308
+_VELTKAMP = 134217729.0  # 2 ** 27 + 1
+# The cell offsets of discsim.cells.neighbour_pairs, in its order.
+_OFFSETS_X = (0, 1, 1, 0, -1)
+_OFFSETS_Y = (0, 0, 1, 1, 1)
+
+
+# --- scalar helpers --------------------------------------------------------------------------------------
+@jit
+def cpython_hypot(x, y):
+    """``math.hypot(x, y)`` as CPython 3.10 and 3.11 compute it (Veltkamp splitting, differential correction).
+
+    Example:
+        >>> cpython_hypot(3.0, 4.0)
+        5.0
+    """
+    x, y = abs(x), abs(y)
+    top = 0.0  # the largest, NaN skipped: hypot(inf, nan) is inf
+    if x > top:
+        top = x
+    if y > top:
+        top = y
+    if math.isinf(top):
+        return top
+    if math.isnan(x) or math.isnan(y):
+        return math.nan
+    if top == 0.0:
+        return top
+    _, top_e = math.frexp(top)
+    if top_e < -1023:  # subnormal: 2 ** -top_e would overflow
+        return _DBL_MIN * cpython_hypot(x / _DBL_MIN, y / _DBL_MIN)
+    scale = math.ldexp(1.0, -top_e)
+    csum, frac1, frac2, frac3 = 1.0, 0.0, 0.0, 0.0
+    for v in (x, y):
+        v = v * scale
+        t = v * _VELTKAMP
+        hi = t - (t - v)
+        lo = v - hi
+        w = hi * hi
+        old = csum
+        csum += w
+        frac1 += (old - csum) + w
+        w = 2.0 * hi * lo
+        old = csum
+        csum += w
+        frac2 += (old - csum) + w
+        frac3 += lo * lo
+    h = math.sqrt(csum - 1.0 + (frac1 + frac2 + frac3))
+    t = h * _VELTKAMP
+    hi = t - (t - h)
+    lo = h - hi
+    w = -hi * hi
+    old = csum
+    csum += w
+    frac1 += (old - csum) + w
+    w = -2.0 * hi * lo
+    old = csum
+    csum += w
+    frac2 += (old - csum) + w
+    w = -lo * lo
+    old = csum
+    csum += w
+    frac3 += (old - csum) + w
+    w = csum - 1.0 + (frac1 + frac2 + frac3)
+    return (h + w / (2.0 * h)) / scale
+
+
+@jit
+def _wrap(v, size):
+    """:meth:`discsim.model.Box.wrap` of one coordinate (periodic box): ``v % size``, the size itself to 0.
+
+    The usual cases are done without the remainder, with the floats it gives (the exact ``fmod`` of a
+    number within one box length of the box is itself, or itself less the length), 4x faster.
+    """
+    if 0.0 < v < size:
+        return v
+    if v == 0.0:
+        return 0.0  # -0.0 % size is +0.0
+    if -size <= v < 0.0:
+        m = v + size
+        return 0.0 if m >= size else m
+    if size <= v < 2.0 * size:
+        return v - size  # exact
+    m = v % size
+    return 0.0 if m >= size else m
+
+
+@jit
+def _image(d, size):
+    """:meth:`discsim.model.Box.minimum_image` of one coordinate: ``d - size * rint(d / size)``.
+
+    Within half a box length ``rint`` gives a zero and ``d`` comes back as it is (a zero as +0.0, as the
+    formula gives it), without the division, 4x faster.
+    """
+    if abs(d) <= 0.5 * size:
+        return d if d != 0.0 else 0.0
+    return d - size * np.rint(d / size)
+
+
+@jit
+def _closest_point(px, py, ax, ay, bx, by):
+    """:func:`discsim.kernels.closest_point_on_segment`."""
+    ex, ey = bx - ax, by - ay
+    u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
+    if 0.0 > u:  # min(max(u, 0.0), 1.0), as Python picks
+        u = 0.0
+    if 1.0 < u:
+        u = 1.0
+    return ax + u * ex, ay + u * ey
+
+
+@jit
+def _reflect(px, py, vx, vy, ax, ay, bx, by):
+    """:func:`discsim.kernels.reflect_off_segment`."""
+    qx, qy = _closest_point(px, py, ax, ay, bx, by)
+    nx, ny = px - qx, py - qy
+    k = 2.0 * (vx * nx + vy * ny) / (nx * nx + ny * ny)
+    return vx - k * nx, vy - k * ny
+
+
+@jit
+def _segment_distance(px, py, ax, ay, bx, by):
+    """:func:`discsim.engines.fixed_step.frame.point_segment_distance` of one point and one segment."""
+    ex, ey = bx - ax, by - ay
+    ee = ex * ex + ey * ey
+    wx, wy = px - ax, py - ay
+    u = (wx * ex + wy * ey) / ee if ee > 0.0 else 0.0
+    u = min(max(u, 0.0), 1.0)
+    return math.hypot(wx - u * ex, wy - u * ey)  # numpy's hypot: the C library's, as numba's
+
+
+@jit
+def _collide(dx, dy, v1x, v1y, v2x, v2y, m1, m2):
+    """:func:`discsim.kernels.resolve_collision`."""
+    d2 = dx * dx + dy * dy
+    b = (v2x - v1x) * dx + (v2y - v1y) * dy
+    if m1 == INF:
+        f1, f2 = 0.0, 2.0
+    elif m2 == INF:
+        f1, f2 = 2.0, 0.0
+    else:
+        f1, f2 = 2.0 * m2 / (m1 + m2), 2.0 * m1 / (m1 + m2)
+    k = b / d2
+    return v1x + f1 * k * dx, v1y + f1 * k * dy, v2x - f2 * k * dx, v2y - f2 * k * dy
+
+
+# --- the event buffer ------------------------------------------------------------------------------------
+# A frame's events go to ``ev_n`` (E, 3) int64: the frame's index in the batch, disc i, disc j (-1 for a
+# wall or segment hit); and ``ev_f`` (E, 8): the discs' positions and velocities after (NaN for no j).
+@jit
+def _grow(ev_n, ev_f, need):
+    """The buffer with room for ``need`` events (copied into larger arrays when short)."""
+    if need <= len(ev_n):
+        return ev_n, ev_f
+    size = max(need, 2 * len(ev_n))
+    new_n = np.empty((size, 3), dtype=np.int64)
+    new_f = np.empty((size, 8))
+    new_n[: len(ev_n)] = ev_n
+    new_f[: len(ev_f)] = ev_f
+    return new_n, new_f
+
+
+@jit
+def _log_wall(ev_n, ev_f, k, frame, i, x, y, vx, vy):
+    """The buffer with the hit of disc ``i`` written at row ``k``."""
+    ev_n, ev_f = _grow(ev_n, ev_f, k + 1)
+    ev_n[k, 0], ev_n[k, 1], ev_n[k, 2] = frame, i, -1
+    ev_f[k, 0], ev_f[k, 1], ev_f[k, 2], ev_f[k, 3] = x, y, vx, vy
+    ev_f[k, 4:] = math.nan
+    return ev_n, ev_f
+
+
+# --- the steps of a frame --------------------------------------------------------------------------------
+@jit
+def _walls(policy, pos, prev, vel, radii, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame):
+    """Discs past a wall and moving outwards: reverse the normal velocity; returns ``(k, ev_n, ev_f)``."""
+    for i in range(len(pos)):
+        r = radii[i]
+        hit = False
+        for axis in range(2):
+            size = width if axis == 0 else height
+            p, v = pos[i, axis], vel[i, axis]
+            low = p < r and v < 0.0
+            high = p > size - r and v > 0.0
+            if low or high:
+                hit = True
+                vel[i, axis] = -v
+                if policy == SEPARATE:
+                    pos[i, axis] = r if low else size - r
+        if not hit:
+            continue
+        if policy == REVERT:
+            pos[i, 0], pos[i, 1] = prev[i, 0], prev[i, 1]
+        ref_pos[i, 0], ref_pos[i, 1] = pos[i, 0], pos[i, 1]
+        ref_t[i] = t
+        ev_n, ev_f = _log_wall(ev_n, ev_f, k, frame, i, pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1])
+        k += 1
+    return k, ev_n, ev_f
+
+
+@jit
+def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r):
+    """One disc cutting the segments ``cut`` (in order): ``(x, y, vx, vy, responded)``.
+
+    ``FramePolicy.off_segments`` (``"resolve"``, ``"separate"``) and ``Revert.off_segments``; ``(px, py)``
+    is the disc's position at the previous frame.
+    """
+    responded = False
+    reverted = False
+    for s in cut:
+        ax, ay, bx, by = segments[s, 0], segments[s, 1], segments[s, 2], segments[s, 3]
+        qx, qy = _closest_point(x, y, ax, ay, bx, by)
+        nx, ny = x - qx, y - qy
+        if policy == REVERT and not reverted:
+            cx, cy = _closest_point(px, py, ax, ay, bx, by)
+            if vx * (px - cx) + vy * (py - cy) < 0.0:  # approaching there: reflect at the restored place
+                x, y, nx, ny = px, py, px - cx, py - cy
+                reverted = True
+            elif vx * nx + vy * ny < 0.0:  # approaching only at the frame: restore, keep the frame's normal
+                fx, fy = x, y
+                x, y = px, py
+                reverted = True
+                vx, vy = _reflect(fx, fy, vx, vy, ax, ay, bx, by)
+                responded = True
+                continue
+        if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
+            continue
+        if policy == SEPARATE:
+            dist = cpython_hypot(nx, ny)
+            if dist < r:
+                x, y = qx + nx / dist * r, qy + ny / dist * r
+        vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by)
+        responded = True
+    return x, y, vx, vy, responded
+
+
+@jit
+def _segments(policy, pos, prev, vel, radii, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame):
+    """Discs cutting a segment, each answered by :func:`_off_segments`; returns ``(k, ev_n, ev_f)``."""
+    cut = np.empty(len(segments), dtype=np.int64)
+    for i in range(len(pos)):
+        x, y, r = pos[i, 0], pos[i, 1], radii[i]
+        m = 0
+        for s in range(len(segments)):
+            if _segment_distance(x, y, segments[s, 0], segments[s, 1], segments[s, 2], segments[s, 3]) < r:
+                cut[m] = s
+                m += 1
+        if m == 0:
+            continue
+        x, y, vx, vy, responded = _off_segments(
+            policy, x, y, vel[i, 0], vel[i, 1], prev[i, 0], prev[i, 1], segments, cut[:m], r
+        )
+        if responded:
+            pos[i, 0], pos[i, 1] = x, y
+            vel[i, 0], vel[i, 1] = vx, vy
+            ref_pos[i, 0], ref_pos[i, 1] = x, y
+            ref_t[i] = t
+            ev_n, ev_f = _log_wall(ev_n, ev_f, k, frame, i, x, y, vx, vy)
+            k += 1
+    return k, ev_n, ev_f
+
+
+@jit
+def _stale(pos, list_pos, periodic, width, height, limit2):
+    """Whether some disc moved more than half the skin since the list was built."""
+    worst = 0.0
+    for i in range(len(pos)):
+        dx, dy = pos[i, 0] - list_pos[i, 0], pos[i, 1] - list_pos[i, 1]
+        if periodic:
+            dx, dy = _image(dx, width), _image(dy, height)
+        worst = max(worst, dx * dx + dy * dy)
+    return worst > limit2
+
+
+@jit
+def _cells(pos, nx, ny, per_x, per_y):
+    """Discs by cell, as :func:`discsim.cells.neighbour_pairs` files them.
+
+    Returns:
+        ``(cx, cy, start, order, rank)``: each disc's cell column and row; the members of cell
+        ``c = cx * ny + cy`` are ``order[start[c]:start[c + 1]]``, in disc order (a stable sort by
+        cell), and disc ``i`` is ``order[rank[i]]``.
+    """
+    n = len(pos)
+    cx = np.empty(n, dtype=np.int64)
+    cy = np.empty(n, dtype=np.int64)
+    start = np.zeros(nx * ny + 1, dtype=np.int64)
+    for i in range(n):
+        cx[i] = min(max(int(pos[i, 0] * per_x), 0), nx - 1)  # int(): truncation, as astype(np.int64)
+        cy[i] = min(max(int(pos[i, 1] * per_y), 0), ny - 1)
+        start[cx[i] * ny + cy[i] + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    order = np.empty(n, dtype=np.int64)
+    rank = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        c = cx[i] * ny + cy[i]
+        order[fill[c]] = i
+        rank[i] = fill[c]
+        fill[c] += 1
+    return cx, cy, start, order, rank
+
+
+@jit
+def _near_pairs(
+    li, lj, pos, cx, cy, start, order, rank, nx, ny, reach2, periodic, width, height, group, blocked, filtering
+):
+    """The pairs of discs in the same or adjacent cells nearer than ``sqrt(reach2)``, as :func:`build_list`.
+
+    Writes the first ones into ``li``, ``lj`` (as many as fit) and returns how many there are (call again
+    with longer arrays if they did not fit: growing them inside the loop costs a third more).
+    """
+    n = len(pos)
+    m = 0
+    single = nx * ny == 1
+    for o in range(1 if single else 5):
+        for i in range(n):
+            if single:  # every pair (i, j > i)
+                first, last = i + 1, n
+            else:
+                ox, oy = cx[i] + _OFFSETS_X[o], cy[i] + _OFFSETS_Y[o]
+                if periodic:
+                    ox, oy = ox % nx, oy % ny
+                elif ox < 0 or ox >= nx or oy >= ny:
+                    continue
+                c = ox * ny + oy
+                first = rank[i] + 1 if o == 0 else start[c]  # the same cell: only later members
+                last = start[c + 1]
+            for p in range(first, last):
+                j = p if single else order[p]
+                if filtering and blocked[group[i], group[j]]:
+                    continue
+                dx, dy = pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]
+                if periodic:
+                    dx, dy = _image(dx, width), _image(dy, height)
+                if dx * dx + dy * dy < reach2:
+                    if m < len(li):
+                        li[m] = i
+                        lj[m] = j
+                    m += 1
+    return m
+
+
+@jit
+def build_list(pos, reach2, nx, ny, per_x, per_y, periodic, width, height, group, blocked, filtering, hint=0):
+    """The Verlet list ``(i, j)``: :func:`discsim.cells.neighbour_pairs` on ``nx x ny`` cells, then filtered.
+
+    The pairs come in ``neighbour_pairs``' order (cell offset, first disc, then rank in the cell), the
+    ones that pass through each other or lie ``sqrt(reach2)`` or farther apart left out, as
+    ``VerletGrid`` builds its list. ``per_x``, ``per_y``: cells per unit length (``nx / width``, ...);
+    ``hint``: the length of the last list (the new one is about as long).
+    """
+    if len(pos) < 2:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    cx, cy, start, order, rank = _cells(pos, nx, ny, per_x, per_y)
+    size = hint + hint // 4 + 64
+    while True:
+        li = np.empty(size, dtype=np.int64)
+        lj = np.empty(size, dtype=np.int64)
+        m = _near_pairs(
+            li, lj, pos, cx, cy, start, order, rank, nx, ny, reach2, periodic, width, height, group, blocked, filtering
+        )
+        if m <= size:
+            return li[:m].copy(), lj[:m].copy()
+        size = m
+
+
+@jit
+def _depth(dx, dy, contact):
+    """``(overlapping, depth)``: whether discs ``(dx, dy)`` apart overlap, and how deep (a fraction of contact)."""
+    dist2 = dx * dx + dy * dy
+    if dist2 < contact * contact:
+        return True, 1.0 - math.sqrt(dist2) / contact
+    return False, 0.0
+
+
+@jit
+def _push(keys, m, key):
+    """``keys`` with ``key`` at index ``m`` (copied into a larger array when full)."""
+    if m == len(keys):
+        grown = np.empty(2 * m, dtype=np.int64)
+        grown[:m] = keys
+        keys = grown
+    keys[m] = key
+    return keys
+
+
+@jit
+def _overlaps(pos, radii, li, lj, all_pairs, periodic, width, height, group, blocked, filtering, overlap):
+    """Overlapping pairs as sorted keys ``min * N + max``, the pairs tested, and the deepest overlap.
+
+    The candidates are the Verlet list ``(li, lj)``, or every pair ``i < j`` (``all_pairs``) less
+    those that pass through each other.
+    """
+    if all_pairs:
+        keys, m, tests, overlap = _overlaps_all(pos, radii, periodic, width, height, group, blocked, filtering, overlap)
+    else:
+        keys = np.empty(len(li), dtype=np.int64)
+        m, overlap = _overlaps_listed(keys, pos, radii, li, lj, periodic, width, height, overlap)
+        tests = len(li)
+    return np.sort(keys[:m]), tests, overlap
+
+
+@jit
+def _overlaps_listed(keys, pos, radii, li, lj, periodic, width, height, overlap):
+    """The pairs of the Verlet list that overlap, as keys written to ``keys``; ``(how many, overlap)``.
+
+    (No array is reassigned in the loop and no function that takes one is called: either costs
+    reference counts on every pass, which made the test of a pair several times slower.)
+    """
+    n = len(pos)
+    m = 0
+    for p in range(len(li)):
+        i, j = li[p], lj[p]
+        dx, dy = pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]
+        if periodic:
+            dx, dy = _image(dx, width), _image(dy, height)
+        hit, depth = _depth(dx, dy, radii[i] + radii[j])
+        if hit:
+            overlap = max(overlap, depth)
+            keys[m] = min(i, j) * n + max(i, j)
+            m += 1
+    return m, overlap
+
+
+@jit
+def _overlaps_all(pos, radii, periodic, width, height, group, blocked, filtering, overlap):
+    """Every pair ``i < j`` that overlaps (the ``"all-pairs"`` broad phase): ``(keys, m, tests, overlap)``."""
+    n = len(pos)
+    keys = np.empty(16, dtype=np.int64)
+    m = 0
+    tests = 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            if filtering and blocked[group[i], group[j]]:
+                continue
+            tests += 1
+            dx, dy = pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]
+            if periodic:
+                dx, dy = _image(dx, width), _image(dy, height)
+            hit, depth = _depth(dx, dy, radii[i] + radii[j])
+            if hit:
+                overlap = max(overlap, depth)
+                keys = _push(keys, m, i * n + j)
+                m += 1
+    return keys, m, tests, overlap
+
+
+@jit
+def _contact(policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j, periodic, width, height):
+    """``FramePolicy.contact`` of each policy: where the discs are left and the line of the impulse."""
+    if policy == REVERT:
+        xi, yi = prev[i, 0], prev[i, 1]
+        xj, yj = prev[j, 0], prev[j, 1]
+        px, py = xj - xi, yj - yi
+        if periodic:
+            px, py = _image(px, width), _image(py, height)
+        if dvx * px + dvy * py < 0.0:  # else keep the frame's line, which is approaching
+            dx, dy = px, py
+    elif policy == SEPARATE:
+        dist = cpython_hypot(dx, dy)
+        depth = sigma - dist
+        if depth > 0.0 and dist > 0.0:
+            if mi == INF:
+                wi, wj = 0.0, 1.0
+            elif mj == INF:
+                wi, wj = 1.0, 0.0
+            else:
+                wi, wj = mj / (mi + mj), mi / (mi + mj)
+            ux, uy = dx / dist, dy / dist
+            xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
+            xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
+            dx, dy = ux * (dist + depth), uy * (dist + depth)
+    return xi, yi, xj, yj, dx, dy
+
+
+@jit
+def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame):
+    """Answer the overlapping pairs in order (keys ``i * N + j``); returns the events written so far.
+
+    Marks the discs that change course in ``changed``; in a periodic box, keeps in ``flown`` where each
+    one's old path put it at ``t`` (``Paths.flown``, not wrapped), for its image count.
+    """
+    ref_pos, vel, ref_t, _ = paths
+    radii, masses, periodic, width, height, _, _, _, _ = scene
+    n = len(pos)
+    for key in keys:
+        i, j = key // n, key % n
+        xi, yi, xj, yj = pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1]
+        dx, dy = xj - xi, yj - yi
+        if periodic:
+            dx, dy = _image(dx, width), _image(dy, height)
+        vxi, vyi, vxj, vyj = vel[i, 0], vel[i, 1], vel[j, 0], vel[j, 1]
+        dvx, dvy = vxj - vxi, vyj - vyi
+        if dvx * dx + dvy * dy >= 0.0:  # separating already (an earlier response this frame)
+            continue
+        mi, mj = masses[i], masses[j]
+        sigma = radii[i] + radii[j]
+        xi, yi, xj, yj, dx, dy = _contact(
+            policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j, periodic, width, height
+        )
+        uxi, uyi, uxj, uyj = _collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+        if periodic:  # no walls: ref_pos, ref_t and vel still hold the path the disc had at the last frame
+            for d in (i, j):
+                if not changed[d]:
+                    for axis in range(2):
+                        flown[d, axis] = ref_pos[d, axis] + vel[d, axis] * (t - ref_t[d])
+        pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1] = xi, yi, xj, yj
+        vel[i, 0], vel[i, 1], vel[j, 0], vel[j, 1] = uxi, uyi, uxj, uyj
+        changed[i] = changed[j] = True
+        ev_n[k, 0], ev_n[k, 1], ev_n[k, 2] = frame, i, j
+        f = ev_f[k]
+        f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7] = xi, yi, uxi, uyi, xj, yj, uxj, uyj
+        k += 1
+    return k
+
+
+# --- the frame -------------------------------------------------------------------------------------------
+#: Slots of the ``counts`` array of :func:`frames`: the engine's counters of the same names.
+C_PAIR_TESTS, C_SEGMENT_TESTS, C_DETECTIONS, C_WALL_HITS, C_LIST_BUILDS = range(5)
+
+
+@jit
+def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap):
+    """One frame at time ``t`` (index ``frame`` in the batch): from ``frame_pos`` (the last frame's
+    positions) to ``pos`` (written); see :func:`frames`.
+
+    Returns:
+        ``(k, ev_n, ev_f, list_pos, list_i, list_j, overlap)``: the events written so far, the buffer, the
+        Verlet list and the deepest overlap.
+    """
+    ref_pos, vel, ref_t, images = paths
+    radii, _, periodic, width, height, segments, group, blocked, filtering = scene
+    all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
+    n = len(ref_pos)
+    for i in range(n):  # Paths.flown, then Box.wrap
+        dt = t - ref_t[i]
+        x, y = ref_pos[i, 0] + vel[i, 0] * dt, ref_pos[i, 1] + vel[i, 1] * dt
+        if periodic:
+            x, y = _wrap(x, width), _wrap(y, height)
+        pos[i, 0], pos[i, 1] = x, y
+    first = k
+    if not periodic:
+        k, ev_n, ev_f = _walls(
+            policy, pos, frame_pos, vel, radii, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame
+        )
+    if len(segments):
+        counts[C_SEGMENT_TESTS] += n * len(segments)
+        k, ev_n, ev_f = _segments(policy, pos, frame_pos, vel, radii, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame)
+    counts[C_WALL_HITS] += k - first
+    if not all_pairs and (len(list_pos) == 0 or _stale(pos, list_pos, periodic, width, height, limit2)):
+        list_i, list_j = build_list(
+            pos, reach2, nx, ny, per_x, per_y, periodic, width, height, group, blocked, filtering, len(list_i)
+        )
+        list_pos = pos.copy()
+        counts[C_LIST_BUILDS] += 1
+    keys, tests, overlap = _overlaps(
+        pos, radii, list_i, list_j, all_pairs, periodic, width, height, group, blocked, filtering, overlap
+    )
+    counts[C_PAIR_TESTS] += tests
+    if len(keys):
+        ev_n, ev_f = _grow(ev_n, ev_f, k + len(keys))
+        changed = np.zeros(n, dtype=np.bool_)
+        flown = np.empty((n if periodic else 0, 2))
+        before = k
+        k = _pairs(policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame)
+        counts[C_DETECTIONS] += k - before
+        for i in range(n):  # Paths.restart
+            if not changed[i]:
+                continue
+            if periodic:
+                images[i, 0] += np.int64(np.rint((flown[i, 0] - pos[i, 0]) / width))
+                images[i, 1] += np.int64(np.rint((flown[i, 1] - pos[i, 1]) / height))
+            ref_pos[i, 0], ref_pos[i, 1] = pos[i, 0], pos[i, 1]
+            ref_t[i] = t
+        if periodic:
+            for i in range(n):
+                pos[i, 0], pos[i, 1] = _wrap(pos[i, 0], width), _wrap(pos[i, 1], height)
+    return k, ev_n, ev_f, list_pos, list_i, list_j, overlap
+
+
+@jit
+def frames(policy, times, scene, paths, broad, counts, overlap):
+    """Frames at ``times`` one after the other: move every disc to the frame, then answer what overlaps there.
+
+    Changes the paths in place, as ``FramePolicy.frame`` changes
+    :class:`~discsim.engines.fixed_step.arrays.Paths`, and adds to ``counts`` (``C_*`` slots). The
+    positions at the last frame come back as a new array (``frame_pos`` may be overwritten).
+
+    Args:
+        policy: :data:`POLICY_CODES`. times ``(F,)``: the frames' times.
+        scene: ``(radii, masses, periodic, width, height, segments, group, blocked, filtering)``:
+            per-disc radii and masses, the box, the segments' end points ``(S, 4)``, the collision
+            filter (``Scene.group``, ``Scene.blocked``, ``Scene.filtering``).
+        paths: ``(ref_pos, vel, ref_t, images, frame_pos)``, as in ``Paths``.
+        broad: ``(all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y)``: every
+            pair (``all_pairs``), or the ``"grid"`` broad phase's Verlet list (``list_pos`` of length 0
+            before the first build), rebuilt when a disc has moved more than ``sqrt(limit2)`` since, from
+            the pairs nearer than ``sqrt(reach2)``, found on ``nx x ny`` cells (``per_x``, ``per_y`` cells
+            per unit length).
+        counts: the counters (int64, changed in place). overlap: the deepest overlap seen so far.
+
+    Returns:
+        ``(ev_n, ev_f, frame_pos, list_pos, list_i, list_j, overlap)``: the events, in order, as ``ev_n``
+        ``(E, 3)`` (frame index in ``times``, disc i, disc j or -1 for a wall or segment hit) and ``ev_f``
+        ``(E, 8)`` (positions and velocities after, as the log holds them); the positions at the last
+        frame; the Verlet list; the deepest overlap.
+    """
+    ref_pos, vel, ref_t, images, frame_pos = paths
+    moving = (ref_pos, vel, ref_t, images)
+    prev, pos = frame_pos, np.empty_like(frame_pos)  # two buffers, swapped after each frame
+    ev_n = np.empty((16, 3), dtype=np.int64)
+    ev_f = np.empty((16, 8))
+    k = 0
+    all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
+    for f in range(len(times)):
+        here = (all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y)
+        k, ev_n, ev_f, list_pos, list_i, list_j, overlap = _frame(
+            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap
+        )
+        prev, pos = pos, prev
+    return ev_n[:k], ev_f[:k], prev, list_pos, list_i, list_j, overlap

@@ -85,7 +85,7 @@ class NumbaBackend:
         order = np.asarray(state.order, dtype=np.int64)
         rank = np.empty(n, dtype=np.int64)
         rank[order] = np.arange(n)
-        self._order, self._rank = order, rank
+        self._order = order.astype(np.int32)  # internal disc k is the caller's disc order[k] (also in the log)
         rec = np.empty((n, 8))
         rec[:, 0:2] = state.ref_positions[order]
         rec[:, 2:4] = state.velocities[order]
@@ -103,18 +103,14 @@ class NumbaBackend:
         n_cells = len(self.grid)
         # Disc and cell indices are int32 (grids hold at most 4 N + 9 cells): a smaller state, fewer misses.
         self._head = np.full(n_cells, -1, dtype=np.int32)
-        self._tail = np.full(n_cells, -1, dtype=np.int32)
         self._nxt = np.full(n, -1, dtype=np.int32)
-        self._prv = np.full(n, -1, dtype=np.int32)
         members = rank[state.cell_members] if n else np.zeros(0, dtype=np.int64)
-        lp.link(members, state.cell_sizes.astype(np.int64), self._head, self._tail, self._nxt, self._prv)
+        lp.link(members, state.cell_sizes.astype(np.int64), self._head, self._nxt)
         # The queue: one slot per disc, and the heap of the discs with a pending event.
         owners = rank[state.queue_owner] if len(state.queue_owner) else np.zeros(0, dtype=np.int64)
-        self._qt = np.full(n, np.inf)
         self._qk = np.zeros(n, dtype=np.int8)
         self._qo = np.zeros(n, dtype=np.int32)
         self._qs = np.zeros(n, dtype=np.int64)
-        self._qt[owners] = state.queue_time
         self._qk[owners] = state.queue_kind
         collision = state.queue_kind == _COLLISION
         self._qo[owners] = np.where(collision, rank[np.where(collision, state.queue_other, 0)], state.queue_other)
@@ -122,12 +118,13 @@ class NumbaBackend:
         self._heap = np.zeros(n, dtype=np.int32)
         self._heap[: len(owners)] = owners
         self._ht = np.zeros(n)
+        self._ht[: len(owners)] = state.queue_time
         self._hpos = np.full(n, -1, dtype=np.int32)
         lp = self._lp
         ints = self._ints = np.zeros(lp.N_INTS, dtype=np.int64)
         floats = self._floats = np.zeros(lp.N_FLOATS)
         ints[lp.I_SIZE] = len(owners)
-        lp.heapify(self._heap, self._ht, self._hpos, self._qt, ints)
+        lp.heapify(self._heap, self._ht, self._hpos, ints)
         ints[lp.I_PRED] = state.predictions
         ints[lp.I_COLL] = state.collisions
         ints[lp.I_WALL] = state.wall_hits
@@ -198,14 +195,14 @@ class NumbaBackend:
             images=caller(self._images),
             collision_counts=caller(self._count),
             cell=caller(self._cell),
-            cell_members=order[members],
+            cell_members=order[members].astype(np.int64),
             cell_sizes=sizes,
             kept_time=caller(rec[:, 7]),
             kept_partner=caller(np.where(partner >= 0, order[np.maximum(partner, 0)], -1)),
             kept_stamp=caller(self._kept_stamp),
-            order=order.copy(),
-            queue_owner=order[owners],
-            queue_time=self._qt[owners].copy(),
+            order=order.astype(np.int64),
+            queue_owner=order[owners].astype(np.int64),
+            queue_time=self._ht[self._hpos[owners]],
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.where(kinds == _COLLISION, others, 0)], others),
             queue_stamp=self._qs[owners].copy(),
@@ -298,17 +295,17 @@ class NumbaBackend:
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, not wrapped."""
         t = self.time - float(self._floats[self._lp.F_EPOCH])
-        rx, ry, vx, vy, tr = self._rec[self._rank, :5].T
+        rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
         return np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)]).reshape(-1, 2)
 
     def unwrapped_positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, each disc followed across the periodic edges."""
-        images = self._images[self._rank].astype(np.float64)
+        images = self._images[self._rank()].astype(np.float64)
         return self.positions() + images * np.array([self.box.width, self.box.height])
 
     def velocities(self) -> np.ndarray:
         """``(N, 2)`` velocities at ``time``."""
-        return self._rec[self._rank, 2:4].copy()
+        return self._rec[self._rank(), 2:4].copy()
 
     def last_event(self) -> tuple[float, int, int, int] | None:
         """``(time, kind, i, j)`` of the last physical event in the caller's numbering, or None."""
@@ -319,12 +316,18 @@ class NumbaBackend:
         order = self._order
         return float(self._floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if j >= 0 else j
 
+    def _rank(self) -> np.ndarray:
+        """Internal number of each caller's disc, ``(N,)`` (built when asked: O(N), as every read that needs it)."""
+        rank = np.empty_like(self._order)
+        rank[self._order] = np.arange(len(self._order))
+        return rank
+
     def nbytes(self) -> int:
         """Bytes of the run state's arrays (per disc, per cell and the queue; not the log buffer)."""
         arrays = (
             self._rec, self._count, self._images, self._kept_partner, self._kept_stamp, self._cell,
-            self._head, self._tail, self._nxt, self._prv, self._qt, self._qk, self._qo, self._qs,
-            self._heap, self._ht, self._hpos, self._order, self._rank, self._group,
+            self._head, self._nxt, self._qk, self._qo, self._qs,
+            self._heap, self._ht, self._hpos, self._order, self._group,
         )  # fmt: skip
         return sum(a.nbytes for a in arrays)
 
@@ -338,14 +341,13 @@ class NumbaBackend:
 
     def _check(self) -> None:
         """Assert the backend's own invariants (heap order and positions, linked cells); O(N)."""
-        size, heap, hpos, qt = self.queue_size(), self._heap, self._hpos, self._qt
+        size, heap, hpos, times = self.queue_size(), self._heap, self._hpos, self._ht
         owners = heap[:size]
-        assert np.array_equal(self._ht[:size], qt[owners]), "heap times out of date"
         assert np.array_equal(hpos[owners], np.arange(size)), "heap positions out of date"
-        assert (hpos >= 0).sum() == size and np.isfinite(qt[owners]).all()
-        parents = owners[(np.arange(1, size) - 1) >> 1]
-        children = owners[1:]
-        ordered = (qt[parents] < qt[children]) | ((qt[parents] == qt[children]) & (parents < children))
+        assert (hpos >= 0).sum() == size and np.isfinite(times[:size]).all()
+        parent = (np.arange(1, size) - 1) >> 1
+        pt, ct, po, co = times[parent], times[1:size], owners[parent], owners[1:]
+        ordered = (pt < ct) | ((pt == ct) & (po < co))
         assert ordered.all(), "heap order broken"
         members = np.zeros(len(self._order), dtype=np.int64)
         sizes = np.zeros(len(self.grid), dtype=np.int64)
@@ -361,7 +363,7 @@ class NumbaBackend:
         return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)
 
     def _queue(self) -> tuple:
-        return (self._heap, self._ht, self._hpos, self._qt, self._qk, self._qo, self._qs, self._ints)
+        return (self._heap, self._ht, self._hpos, self._qk, self._qo, self._qs, self._ints)
 
     def _predict_args(self) -> tuple:
         return (
@@ -372,7 +374,7 @@ class NumbaBackend:
     def _loop_args(self) -> tuple:
         return (
             self._rec, self._count, self._order, self._images, self._kept_partner, self._kept_stamp,
-            self._cell, self._head, self._tail, self._nxt, self._prv,
+            self._cell, self._head, self._nxt,
             *self._geometry(), *self._filter(), *self._queue(), self._floats,
         )  # fmt: skip
 

@@ -10,10 +10,10 @@ only the data structures differ:
 
 - ``rec`` ``(N, 8)`` float64, one 64-byte row per disc (one cache line): x, y, vx, vy, t_ref, radius,
   mass (inf for an obstacle), and the time of the disc's kept collision;
-- cells as doubly linked lists (``head``, ``tail`` per cell; ``nxt``, ``prv`` per disc), which keep
+- cells as singly linked lists (``head`` per cell, ``nxt`` per disc), which keep
   each cell's members in the order they entered, as the Python backend's tuples do;
 - the queue, an indexed binary heap of owners ordered by ``(time, owner)`` with one pending event
-  per disc (``qt``, ``qk``, ``qo``, ``qs``: time, kind, other, stamp), popping in the same order as
+  per disc (``qk``, ``qo``, ``qs``: kind, other, stamp), popping in the same order as
   the Python backend's queues;
 - counters and scalars in two small arrays, ``ints`` and ``floats`` (the ``I_*`` and ``F_*`` slots).
 """
@@ -53,8 +53,8 @@ DONE, MORE, CROSSINGS = 0, 1, 2
 
 # --- the queue: an indexed binary heap of owners, ordered by (time, owner) ------------------------------
 # ``heap[k]`` is the owner at position k and ``ht[k]`` its time (kept beside it, so that a comparison reads
-# no other array); ``hpos[owner]`` is the owner's position, -1 when it has no pending event. ``qt[owner]``
-# holds the same time for reads by owner.
+# no other array); ``hpos[owner]`` is the owner's position, -1 when it has no pending event, so an
+# owner's pending time is ``ht[hpos[owner]]``.
 @jit
 def _sift_up(k, heap, ht, hpos):
     owner = heap[k]
@@ -125,13 +125,12 @@ def _remove(owner, heap, ht, hpos, ints):
 
 
 @jit
-def push(owner, t, kind, other, stamp, heap, ht, hpos, qt, qk, qo, qs, ints):
+def push(owner, t, kind, other, stamp, heap, ht, hpos, qk, qo, qs, ints):
     """Schedule ``owner``'s event at ``t`` (finite), replacing its pending one.
 
     The loop leaves a popped event at the top of the heap until its owner is predicted again, so
     that the new event replaces it with one sift instead of a removal and an insertion.
     """
-    qt[owner] = t
     qk[owner] = kind
     qo[owner] = other
     qs[owner] = stamp
@@ -152,19 +151,17 @@ def push(owner, t, kind, other, stamp, heap, ht, hpos, qt, qk, qo, qs, ints):
 
 
 @jit
-def discard(owner, heap, ht, hpos, qt, ints):
+def discard(owner, heap, ht, hpos, ints):
     """Drop ``owner``'s pending event, if any."""
     if hpos[owner] >= 0:
         _remove(owner, heap, ht, hpos, ints)
-    qt[owner] = INF
 
 
 @jit
-def heapify(heap, ht, hpos, qt, ints):
-    """Rebuild the heap of the owners it holds from their times ``qt`` (after every time moved)."""
+def heapify(heap, ht, hpos, ints):
+    """Restore the heap order of the entries ``heap[:size]``, ``ht[:size]`` (after every time moved)."""
     size = ints[I_SIZE]
     for k in range(size):
-        ht[k] = qt[heap[k]]
         hpos[heap[k]] = k
     for k in range((size >> 1) - 1, -1, -1):
         _sift_down(k, size, heap, ht, hpos)
@@ -232,7 +229,7 @@ def predict(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, width, height, periodic, col_lo, row_lo,
     seg, seg_start, seg_idx, filtering, group, blocked,
-    heap, ht, hpos, qt, qk, qo, qs, ints,
+    heap, ht, hpos, qk, qo, qs, ints,
 ):  # fmt: skip
     """Schedule disc ``i``'s earliest event after ``t``, as the Python backend's ``predict`` does.
 
@@ -379,11 +376,11 @@ def predict(
     # 3. Schedule the earlier of the two.
     t_best = t + best
     if t_hit <= t_best and partner >= 0:
-        push(i, t_hit, COLLISION, partner, count[partner], heap, ht, hpos, qt, qk, qo, qs, ints)
+        push(i, t_hit, COLLISION, partner, count[partner], heap, ht, hpos, qk, qo, qs, ints)
     elif best == INF:
-        discard(i, heap, ht, hpos, qt, ints)
+        discard(i, heap, ht, hpos, ints)
     else:
-        push(i, t_best, kind, other, 0, heap, ht, hpos, qt, qk, qo, qs, ints)
+        push(i, t_best, kind, other, 0, heap, ht, hpos, qk, qo, qs, ints)
 
 
 @jit
@@ -391,7 +388,7 @@ def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, width, height, periodic, col_lo, row_lo,
     seg, seg_start, seg_idx, filtering, group, blocked,
-    heap, ht, hpos, qt, qk, qo, qs, ints,
+    heap, ht, hpos, qk, qo, qs, ints,
 ):  # fmt: skip
     """The start of a run: predict every moving disc at time 0, in internal order."""
     for i in range(rec.shape[0]):
@@ -400,14 +397,14 @@ def predict_all(
                 i, 0.0, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, ht, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
     ints[I_MAXQ] = ints[I_SIZE]
 
 
 # --- cells ---------------------------------------------------------------------------------------------
 @jit
-def link(members, sizes, head, tail, nxt, prv):
+def link(members, sizes, head, nxt):
     """Build the cells' linked lists from ``members`` (internal numbers, cell by cell) and ``sizes``."""
     k = 0
     for c in range(sizes.shape[0]):
@@ -416,14 +413,12 @@ def link(members, sizes, head, tail, nxt, prv):
         for _ in range(sizes[c]):
             j = members[k]
             k += 1
-            prv[j] = previous
             nxt[j] = -1
             if previous < 0:
                 head[c] = j
             else:
                 nxt[previous] = j
             previous = j
-        tail[c] = previous
 
 
 @jit
@@ -441,50 +436,52 @@ def unlink(head, nxt, members, sizes):
         sizes[c] = n
 
 
+# Cells are singly linked lists in the order their discs entered (as the Python backend's tuples): a cell
+# holds a disc or two, so walking it to leave or to join costs less than a second link per disc and a tail
+# per cell would in memory.
 @jit
-def _leave(i, c, head, tail, nxt, prv):
-    p, q = prv[i], nxt[i]
-    if p < 0:
-        head[c] = q
-    else:
-        nxt[p] = q
-    if q < 0:
-        tail[c] = p
-    else:
-        prv[q] = p
+def _leave(i, c, head, nxt):
+    j = head[c]
+    if j == i:
+        head[c] = nxt[i]
+        return
+    while nxt[j] != i:
+        j = nxt[j]
+    nxt[j] = nxt[i]
 
 
 @jit
-def _enter(i, c, head, tail, nxt, prv):
-    last = tail[c]
-    prv[i] = last
+def _enter(i, c, head, nxt):
     nxt[i] = -1
-    if last < 0:
+    j = head[c]
+    if j < 0:
         head[c] = i
-    else:
-        nxt[last] = i
-    tail[c] = i
+        return
+    while nxt[j] >= 0:
+        j = nxt[j]
+    nxt[j] = i
 
 
 # --- the hot loop --------------------------------------------------------------------------------------
 @jit
-def rebase(shift, rec, heap, ht, hpos, qt, ints, floats):
+def rebase(shift, rec, heap, ht, hpos, ints, floats):
     """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``."""
     for i in range(rec.shape[0]):
         rec[i, T] -= shift
         rec[i, KEPT] = rec[i, KEPT] - shift
-        qt[i] = qt[i] - shift
-    heapify(heap, ht, hpos, qt, ints)
+    for k in range(ints[I_SIZE]):
+        ht[k] = ht[k] - shift
+    heapify(heap, ht, hpos, ints)
     floats[F_EPOCH] += shift
 
 
 @jit
 def run_events(
     until, limit, crossings, budget, rebase_every, recording,
-    rec, count, order, images, kept_partner, kept_stamp, cell, head, tail, nxt, prv,
+    rec, count, order, images, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, width, height, periodic, col_lo, row_lo,
     seg, seg_start, seg_idx, filtering, group, blocked,
-    heap, ht, hpos, qt, qk, qo, qs, ints, floats,
+    heap, ht, hpos, qk, qo, qs, ints, floats,
     ev_t, ev_kind, ev_i, ev_j, ev_f,
 ):  # fmt: skip
     """Process events with times <= ``until``: the Python backend's ``_process_events``, compiled.
@@ -535,7 +532,7 @@ def run_events(
                     i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, width, height, periodic, col_lo, row_lo,
                     seg, seg_start, seg_idx, filtering, group, blocked,
-                    heap, ht, hpos, qt, qk, qo, qs, ints,
+                    heap, ht, hpos, qk, qo, qs, ints,
                 )  # fmt: skip
                 continue
             vxi = rec[i, VX]
@@ -590,7 +587,7 @@ def run_events(
                 i, t, j, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, ht, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
             if mj != INF:  # obstacles never move, and their counter never changes
                 count[j] += 1
@@ -598,7 +595,7 @@ def run_events(
                     j, t, i, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, width, height, periodic, col_lo, row_lo,
                     seg, seg_start, seg_idx, filtering, group, blocked,
-                    heap, ht, hpos, qt, qk, qo, qs, ints,
+                    heap, ht, hpos, qk, qo, qs, ints,
                 )  # fmt: skip
                 if ints[I_SIZE] > max_queue:
                     max_queue = ints[I_SIZE]
@@ -636,12 +633,12 @@ def run_events(
                 i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, ht, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
         else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
             c = cell[i]
-            _leave(i, c, head, tail, nxt, prv)
+            _leave(i, c, head, nxt)
             cx = c // ny
             cy = c - cx * ny
             if other == PLUS_X:
@@ -670,13 +667,13 @@ def run_events(
                     images[i, 1] -= 1
             c = cx * ny + cy
             cell[i] = c
-            _enter(i, c, head, tail, nxt, prv)
+            _enter(i, c, head, nxt)
             n_cross += 1
             predict(
                 i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, width, height, periodic, col_lo, row_lo,
                 seg, seg_start, seg_idx, filtering, group, blocked,
-                heap, ht, hpos, qt, qk, qo, qs, ints,
+                heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
             if n_cross == crossings:
                 now = t
@@ -686,7 +683,7 @@ def run_events(
         now = t
         have_now = True
         if done >= rebase_at:
-            rebase(now, rec, heap, ht, hpos, qt, ints, floats)
+            rebase(now, rec, heap, ht, hpos, ints, floats)
             epoch = floats[F_EPOCH]
             now = 0.0
             horizon = until - epoch

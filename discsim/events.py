@@ -14,14 +14,25 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["COLLISION", "EVENT_DTYPE", "KIND_NAMES", "WALL", "Event", "EventKind", "EventLog", "event_from_record"]
+__all__ = [
+    "COLLISION",
+    "EVENT_DTYPE",
+    "KIND_NAMES",
+    "SET",
+    "WALL",
+    "Event",
+    "EventKind",
+    "EventLog",
+    "event_from_record",
+]
 
 
 class EventKind(IntEnum):
     """The one numbering of event kinds, in the log (``kind`` field) and in the engines' queues.
 
-    The log holds ``COLLISION`` (disc-disc) and ``WALL`` (a wall or a segment
-    hit) only; ``CROSSING`` (a disc enters another cell) and ``SEGMENT`` (a
+    The log holds ``COLLISION`` (disc-disc), ``WALL`` (a wall or a segment
+    hit) and ``SET`` (a disc changed by the user: ``set_velocities``, ``apply_impulse``,
+    ``set_positions``; ``j`` is -1) only; ``CROSSING`` (a disc enters another cell) and ``SEGMENT`` (a
     segment hit, logged as ``WALL``) live in the engines' queues.
     """
 
@@ -29,11 +40,13 @@ class EventKind(IntEnum):
     WALL = 1
     CROSSING = 2
     SEGMENT = 3
+    SET = 4
 
 
 COLLISION = int(EventKind.COLLISION)
 WALL = int(EventKind.WALL)
-KIND_NAMES = {COLLISION: "collision", WALL: "wall"}
+SET = int(EventKind.SET)
+KIND_NAMES = {COLLISION: "collision", WALL: "wall", SET: "set"}
 
 
 class Event(NamedTuple):
@@ -41,7 +54,7 @@ class Event(NamedTuple):
 
     Attributes:
         time: when it happened.
-        kind: ``"collision"`` (disc-disc) or ``"wall"``.
+        kind: ``"collision"`` (disc-disc), ``"wall"``, or ``"set"`` (a change made by the user).
         i: the first disc. j: the second disc, or -1 for a wall hit.
     """
 
@@ -96,6 +109,10 @@ class EventLog:
     def wall(self, t, i, xi, yi, vxi, vyi) -> None:
         """Record a wall hit of disc ``i`` at time ``t`` with its state after it."""
         self._rows.append((t, WALL, i, -1, xi, yi, vxi, vyi, _NAN, _NAN, _NAN, _NAN))
+
+    def set(self, t, i, xi, yi, vxi, vyi) -> None:
+        """Record that the user changed disc ``i`` at time ``t``, with its state after the change (rare: one copy)."""
+        self.extend(np.array([(t, SET, i, -1, xi, yi, vxi, vyi, _NAN, _NAN, _NAN, _NAN)], dtype=EVENT_DTYPE))
 
     def extend(self, records: np.ndarray) -> None:
         """Append records given as a structured array of :data:`EVENT_DTYPE`."""

@@ -28,9 +28,16 @@ from typing import ClassVar
 
 import numpy as np
 
-from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
+from discsim.errors import (
+    CheckpointError,
+    DiscsimError,
+    InvalidArgumentError,
+    OutsideBoxError,
+    OverlapError,
+    UnitsError,
+)
 from discsim.events import EVENT_DTYPE, EventLog
-from discsim.model import Box, Discs, kinetic_energy, momentum
+from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, kinetic_energy, momentum
 from discsim.scene import Scene
 from discsim.trajectory import positions_from_log
 
@@ -105,6 +112,8 @@ class Engine(ABC):
         self._broken: str | None = None  # why the engine cannot go on (an exception inside its loop)
         self._run_id: str | None = None  # identifies this run in its checkpoints and streamed log
         self._stream: dict | None = None  # this run's log on disk: path, run_id, base, records, end
+        self._edits = 0  # discs changed by the user (one SET record each in a recorded log)
+        self._handlers: dict[str, list] = {}  # sim.on(kind, fn): callbacks after each event of that kind
 
     # --- the driver's protocol ---------------------------------------------------------
     @abstractmethod
@@ -178,6 +187,205 @@ class Engine(ABC):
     @abstractmethod
     def step(self):
         """Advance by one unit of work (an event, or a frame) and return what happened."""
+
+    @abstractmethod
+    def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
+        """Restart the paths of moving discs ``indices`` ``(K,)`` at ``time`` with ``velocities`` ``(K, 2)`` from
+        ``positions`` ``(K, 2)`` (in the box), or from where they are (None). Checked by the caller."""
+
+    # --- changing the simulation ----------------------------------------------------------
+    #: Event kinds a callback can follow with :meth:`on`.
+    CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment")
+
+    def set_velocities(self, indices, velocities):
+        """Give discs ``indices`` new ``velocities`` ``(K, 2)`` (or one ``(2,)`` for all) at ``time``.
+
+        Each change is an event of its own in the log (kind ``"set"``), so :meth:`trajectory` stays exact;
+        only the discs changed are re-predicted. Returns ``self``.
+
+        Raises:
+            InvalidArgumentError: an index that is not a disc, a repeated index, a wrong shape, a NaN or
+                infinite velocity, or an obstacle (infinite mass; obstacles stay where they are).
+            UnitsError: a speed outside the supported range. Nothing changes then.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[0.0, 0.0], [0.0, 0.0]], 1.0), ds.Box(10, 10))
+            >>> sim.set_velocities([0], [[1.0, 0.0]]).run(until=5.0).velocities.tolist()
+            [[0.0, 0.0], [1.0, 0.0]]
+        """
+        idx = self._disc_indices(indices)
+        self._change(idx, None, self._rows("velocities", velocities, idx))
+        return self
+
+    def apply_impulse(self, indices, impulses):
+        """Push discs ``indices`` with ``impulses`` ``(K, 2)`` (momentum, or one ``(2,)`` for all): ``dv = J / m``.
+
+        Returns ``self``. Raises as :meth:`set_velocities` (obstacles refuse to be pushed).
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], 1.0, masses=2.0), ds.Box(10, 10))
+            >>> sim.apply_impulse([0], [0.0, 4.0]).velocities.tolist()
+            [[1.0, 2.0]]
+        """
+        idx = self._disc_indices(indices)
+        impulses = self._rows("impulses", impulses, idx)
+        self._refuse_obstacles(idx)
+        velocities = self.velocities[idx] + impulses / self.discs.masses[idx][:, None]
+        self._change(idx, None, velocities)
+        return self
+
+    def set_positions(self, indices, positions):
+        """Move discs ``indices`` to ``positions`` ``(K, 2)`` at ``time``, keeping their velocities.
+
+        Validated as the constructor validates: each disc must lie in the box (in ``[0, width) x
+        [0, height)`` when periodic), clear of the walls, the segments and every other disc (pairs that
+        pass through each other excepted). Returns ``self``.
+
+        Raises:
+            OutsideBoxError, OverlapError: naming the disc (and the disc it would overlap).
+            InvalidArgumentError: as :meth:`set_velocities`. Nothing changes then.
+        """
+        idx = self._disc_indices(indices)
+        self._change(idx, self._rows("positions", positions, idx), None)
+        return self
+
+    def on(self, kind: str, fn):
+        """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"`` or ``"segment"``).
+
+        ``contact`` is a :class:`~discsim.analysis.contacts.Contact` (time, kind, discs, contact point,
+        unit normal, impulse, normal speed). The callback may change the simulation (``set_velocities``,
+        ``apply_impulse``, ``set_positions``) and the run goes on exactly from there. While a callback is
+        registered, ``run()`` advances one physical event (or frame) at a time, so each callback sees the
+        state just after its event: see the README for the cost. Returns ``self``.
+
+        Raises:
+            InvalidArgumentError: an unknown kind (naming it) or a ``fn`` that is not callable.
+        """
+        if not isinstance(kind, str) or kind not in self.CALLBACK_KINDS:
+            msg = f"on() follows one of {list(self.CALLBACK_KINDS)}, got {kind!r}"
+            raise InvalidArgumentError(msg)
+        if not callable(fn):
+            msg = f"on({kind!r}, fn) needs a callable fn(sim, contact), got {type(fn).__name__}"
+            raise InvalidArgumentError(msg)
+        self._handlers.setdefault(kind, []).append(fn)
+        return self
+
+    def _disc_indices(self, indices) -> np.ndarray:
+        """``indices`` as a ``(K,)`` int array of distinct existing discs."""
+        n = len(self.discs)
+        try:
+            idx = np.atleast_1d(np.asarray(indices))
+        except (TypeError, ValueError) as exc:
+            msg = f"indices must be integers in [0, {n}), got {indices!r}"
+            raise InvalidArgumentError(msg) from exc
+        if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
+            msg = f"indices must be a list of integers in [0, {n}), got {indices!r}"
+            raise InvalidArgumentError(msg)
+        idx = idx.astype(np.int64)
+        bad = (idx < 0) | (idx >= n)
+        if bad.any():
+            msg = f"disc index {int(idx[bad][0])} does not exist (this simulation has discs 0 to {n - 1})"
+            raise InvalidArgumentError(msg)
+        unique, counts = np.unique(idx, return_counts=True)
+        if (counts > 1).any():
+            msg = f"disc index {int(unique[counts > 1][0])} is given twice"
+            raise InvalidArgumentError(msg)
+        return idx
+
+    @staticmethod
+    def _rows(name: str, values, idx: np.ndarray) -> np.ndarray:
+        """``values`` as a finite ``(K, 2)`` float array (one ``(2,)`` row is repeated for every disc)."""
+        try:
+            rows = np.array(values, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            msg = f"{name} must be numbers of shape ({len(idx)}, 2), got {values!r}"
+            raise InvalidArgumentError(msg) from exc
+        if rows.shape == (2,):
+            rows = np.tile(rows, (len(idx), 1))
+        if rows.shape != (len(idx), 2):
+            msg = f"{name} must have shape ({len(idx)}, 2) for {len(idx)} discs, got shape {rows.shape}"
+            raise InvalidArgumentError(msg)
+        bad = ~np.isfinite(rows).all(axis=1)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            msg = f"disc {int(idx[k])} would get non-finite {name} {rows[k].tolist()}"
+            raise InvalidArgumentError(msg)
+        return rows
+
+    def _refuse_obstacles(self, idx: np.ndarray) -> None:
+        fixed = np.isinf(self.discs.masses[idx])
+        if fixed.any():
+            msg = f"disc {int(idx[fixed][0])} is an obstacle (infinite mass): it cannot be moved or pushed"
+            raise InvalidArgumentError(msg)
+
+    def _change(self, idx: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray | None) -> None:
+        """Check every change first, then make them all, log them, and count them."""
+        self._check_usable()
+        self._refuse_obstacles(idx)
+        if velocities is None:
+            velocities = self.velocities[idx]
+        speed = np.hypot(velocities[:, 0], velocities[:, 1])
+        lo, hi = SPEED_RANGE
+        bad = (speed > hi) | ((speed < lo) & (speed != 0.0))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            msg = (
+                f"disc {int(idx[k])} would get speed {float(speed[k])!r}, outside the range discsim supports "
+                f"([{lo:g}, {hi:g}] or 0; discsim.model.SPEED_RANGE)"
+            )
+            raise UnitsError(msg)
+        if positions is not None:
+            self._check_places(idx, positions)
+        if len(idx):
+            self._set_discs(idx, positions, velocities)
+        self._edits += len(idx)
+        if (self._logging or self._stream is not None) and len(idx):  # a streamed log takes it at the next run
+            t, pos, vel = self.time, self.positions[idx], self.velocities[idx]
+            for k, i in enumerate(idx.tolist()):
+                self._log.set(t, i, pos[k, 0], pos[k, 1], vel[k, 0], vel[k, 1])
+
+    def _check_places(self, idx: np.ndarray, positions: np.ndarray) -> None:
+        """Refuse positions outside the box, cut by a wall or a segment, or overlapping another disc."""
+        box, radii = self.box, self.discs.radii
+        size = box.size
+        for k, i in enumerate(idx.tolist()):
+            p, r = positions[k], radii[i]
+            if box.periodic:
+                outside, what = bool(((p < 0) | (p >= size)).any()), "outside the periodic box [0, width) x [0, height)"
+            else:
+                slack = OVERLAP_TOLERANCE * r
+                outside, what = (
+                    bool(((p - r < -slack) | (p + r > size + slack)).any()),
+                    "outside the box or cut by a wall",
+                )
+            if outside:
+                msg = f"disc {i} at {p.tolist()} with radius {r:g} would be {what} (box {box.width:g} x {box.height:g})"
+                raise OutsideBoxError(msg)
+            for s, segment in enumerate(self.segments):
+                if float(segment.distance(p[None, :])[0]) < r * (1.0 - OVERLAP_TOLERANCE):
+                    msg = f"disc {i} at {p.tolist()} with radius {r:g} would be cut by segment {s} {segment!r}"
+                    raise OutsideBoxError(msg)
+        places = np.array(self.positions)  # a writable copy
+        places[idx] = positions
+        everyone = np.arange(len(radii))
+        for k, i in enumerate(idx.tolist()):
+            d = box.minimum_image(places - places[i])
+            dist = np.hypot(d[:, 0], d[:, 1])
+            contact = radii + radii[i]
+            depth = contact - dist
+            bad = depth > OVERLAP_TOLERANCE * contact
+            bad[i] = False
+            if self.scene.filtering:
+                bad &= ~self.scene.passes(np.full(len(radii), i), everyone)
+            if bad.any():
+                j = int(np.flatnonzero(bad)[np.argmax((depth / contact)[bad])])
+                msg = (
+                    f"disc {i} at {positions[k].tolist()} would overlap disc {j} by {depth[j]:.6g} "
+                    f"(distance {dist[j]:.6g}, contact distance {contact[j]:.6g})"
+                )
+                raise OverlapError(msg)
 
     # --- derived -------------------------------------------------------------------------
     def run(

@@ -21,7 +21,7 @@ from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError, JammedError
 from discsim.events import KIND_NAMES, Event
-from discsim.model import Box, Discs
+from discsim.model import Box, Discs, _readonly
 from discsim.scene import Scene
 
 __all__ = ["BACKENDS", "EventDriven"]
@@ -144,6 +144,7 @@ class EventDriven(Engine):
             "queue": self.queue_kind,
             "cell_size": self.cell_size,
             "backend": self.backend,
+            "edits": self._edits,
         }
 
     @classmethod
@@ -163,6 +164,7 @@ class EventDriven(Engine):
         if len(events):
             sim._log.extend(events)
         sim.start_time = start_time
+        sim._edits = int(settings.get("edits", 0))
         return sim
 
     # --- the driver's protocol -----------------------------------------------------------
@@ -180,7 +182,15 @@ class EventDriven(Engine):
         counts = self._backend.counts()
         return counts["collisions"] + counts["wall_hits"]
 
-    _event_count = _units  # every physical event is one log record
+    def _event_count(self) -> int:
+        """Log records since the start: one per physical event and one per disc the user changed."""
+        return self._units() + self._edits
+
+    def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
+        set_disc = self._backend.set_disc
+        for k, i in enumerate(indices.tolist()):
+            vx, vy = velocities[k].tolist()
+            set_disc(i, vx, vy, None if positions is None else tuple(positions[k].tolist()))
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None
@@ -338,8 +348,11 @@ class EventDriven(Engine):
 
     @property
     def positions(self) -> np.ndarray:
-        """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
-        return self.box.wrap(self._backend.positions())
+        """``(N, 2)`` centres at ``time`` (a fresh read-only copy; wrapped into a periodic box).
+
+        Read-only so that ``sim.positions[0] = ...`` raises: change discs with :meth:`set_positions`.
+        """
+        return _readonly(self.box.wrap(self._backend.positions()))
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
@@ -348,12 +361,12 @@ class EventDriven(Engine):
         In a walled box, the same as :attr:`positions`. ``unwrapped_positions - discs.positions`` is each
         disc's displacement since the start, as a mean-squared displacement needs.
         """
-        return self._backend.unwrapped_positions()
+        return _readonly(self._backend.unwrapped_positions())
 
     @property
     def velocities(self) -> np.ndarray:
-        """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
-        return self._backend.velocities()
+        """``(N, 2)`` velocities at ``time`` (a fresh read-only copy: change them with :meth:`set_velocities`)."""
+        return _readonly(self._backend.velocities())
 
     @property
     def counts(self) -> dict[str, int]:

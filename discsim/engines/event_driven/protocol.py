@@ -49,6 +49,11 @@ class Backend(Protocol):
         after ``crossings`` cell crossings if given; log each physical event in ``log`` (None: none).
         Returns the physical events processed."""
 
+    def set_disc(self, i: int, vx: float, vy: float, position: tuple[float, float] | None = None) -> None:
+        """Give moving disc ``i`` velocity ``(vx, vy)`` (and ``position``, in the box) at ``time``: restart its
+        path, move its collision counter on (events predicted against it go stale), move it to its new cell,
+        and re-predict it alone."""
+
     def counts(self) -> dict[str, int]:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
 

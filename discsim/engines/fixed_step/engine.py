@@ -43,7 +43,7 @@ from discsim.engines.fixed_step.state import FixedStepState
 from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisect
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
-from discsim.model import Box, Discs
+from discsim.model import Box, Discs, _readonly
 from discsim.scene import Scene
 
 __all__ = ["BACKENDS", "BROAD_PHASES", "COMPILED_POLICIES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
@@ -270,6 +270,7 @@ class FixedStep(Engine):
             "broad_phase": self.broad_phase,
             "bisect_tol": self.bisect_tol,
             "backend": self.backend,
+            "edits": self._edits,
         }
 
     @classmethod
@@ -291,6 +292,7 @@ class FixedStep(Engine):
             backend,
         )
         sim.start_time = start_time
+        sim._edits = int(settings.get("edits", 0))
         sim._load(state)
         if len(events):
             sim._log.extend(events)
@@ -357,7 +359,17 @@ class FixedStep(Engine):
     def _event_count(self) -> int:
         """Log records produced since the start: one per detection and one per wall or segment hit."""
         counts = self._tally.counts
-        return counts["detections"] + counts["wall_hits"]
+        return counts["detections"] + counts["wall_hits"] + self._edits
+
+    def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
+        paths, t = self._paths, self.time
+        flown = paths.flown(t)
+        for k, i in enumerate(indices.tolist()):
+            x, y = (flown[i] if positions is None else positions[k]).tolist()
+            vx, vy = velocities[k].tolist()
+            x, y = paths.turn(i, t, x, y, vx, vy)
+            if positions is not None or t == self._frame_time:
+                paths.frame_positions[i] = (x, y)  # a disc set somewhere counts as having been there at the frame
 
     def _settle(self, until: float) -> None:
         """Move the clock to ``until``: the discs drift straight from the last frame; the frame grid stays."""
@@ -488,8 +500,8 @@ class FixedStep(Engine):
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
         if self.time == self._frame_time:
-            return self._paths.frame_positions.copy()
-        return self.box.wrap(self._paths.flown(self.time))
+            return _readonly(self._paths.frame_positions.copy())
+        return _readonly(self.box.wrap(self._paths.flown(self.time)))
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
@@ -506,12 +518,12 @@ class FixedStep(Engine):
         """
         if not self.box.periodic:
             return self.positions
-        return self._paths.unwrapped(self.time)
+        return _readonly(self._paths.unwrapped(self.time))
 
     @property
     def velocities(self) -> np.ndarray:
         """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
-        return self._paths.velocities.copy()
+        return _readonly(self._paths.velocities.copy())
 
     def frame_time(self, k):
         """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""

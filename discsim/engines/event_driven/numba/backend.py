@@ -255,6 +255,23 @@ class NumbaBackend:
             if not interrupted[0]:
                 return done
 
+    def set_disc(self, i: int, vx: float, vy: float, position: tuple[float, float] | None = None) -> None:
+        """As :meth:`discsim.engines.event_driven.python.PythonBackend.set_disc`: restart moving disc ``i``'s
+        path at ``time`` with ``(vx, vy)`` (and ``position``, in the box), stale every event predicted against
+        it, move it to its new cell and re-predict it alone."""
+        lp, rec = self._lp, self._rec
+        k = int(np.flatnonzero(self._order == i)[0])
+        t = self.time - float(self._floats[lp.F_EPOCH])
+        if position is None:
+            dt = t - float(rec[k, 4])
+            x = float(rec[k, 0]) + float(rec[k, 2]) * dt
+            y = float(rec[k, 1]) + float(rec[k, 3]) * dt
+            cell = int(self._cell[k])
+        else:
+            x, y = float(position[0]), float(position[1])
+            cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
+        lp.set_disc(k, x, y, float(vx), float(vy), cell, t, *self._predict_args())
+
     # --- cheap reads -----------------------------------------------------------------------
     @property
     def time(self) -> float:

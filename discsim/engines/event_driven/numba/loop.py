@@ -402,6 +402,37 @@ def predict_all(
     ints[I_MAXQ] = ints[I_SIZE]
 
 
+@jit
+def set_disc(
+    i, x, y, vx, vy, new_cell, t,
+    rec, count, kept_partner, kept_stamp, cell, head, nxt,
+    nx, ny, width, height, periodic, col_lo, row_lo,
+    seg, seg_start, seg_idx, filtering, group, blocked,
+    heap, ht, hpos, qk, qo, qs, ints,
+):  # fmt: skip
+    """Restart disc ``i``'s path at ``t`` from ``(x, y)`` with ``(vx, vy)`` (in cell ``new_cell``), as the Python
+    backend's ``set_disc``: its counter moves on (events predicted against it go stale) and it alone is re-predicted.
+    """
+    if new_cell != cell[i]:
+        _leave(i, cell[i], head, nxt)
+        _enter(i, new_cell, head, nxt)
+        cell[i] = new_cell
+    rec[i, X] = x
+    rec[i, Y] = y
+    rec[i, VX] = vx
+    rec[i, VY] = vy
+    rec[i, T] = t
+    count[i] += 1
+    predict(
+        i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+        nx, ny, width, height, periodic, col_lo, row_lo,
+        seg, seg_start, seg_idx, filtering, group, blocked,
+        heap, ht, hpos, qk, qo, qs, ints,
+    )  # fmt: skip
+    if ints[I_SIZE] > ints[I_MAXQ]:
+        ints[I_MAXQ] = ints[I_SIZE]
+
+
 # --- cells ---------------------------------------------------------------------------------------------
 @jit
 def link(members, sizes, head, nxt):

@@ -51,7 +51,9 @@ _TILE = TILE
 
 INF = math.inf
 # Kinds of queued events, as plain ints for the hot loop (one numbering: EventKind).
-_COLLISION, _WALL, _CROSSING, _SEGMENT = (int(k) for k in EventKind)
+_COLLISION, _WALL, _CROSSING, _SEGMENT = (
+    int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT)
+)
 # Physical events between moves of the internal clock's epoch (at least 16 per disc).
 _REBASE_EVENTS = 1 << 18
 # Directions of a cell crossing.
@@ -249,6 +251,47 @@ class PythonBackend:
         finally:
             if collecting:
                 gc.enable()
+
+    def set_disc(self, i: int, vx: float, vy: float, position: tuple[float, float] | None = None) -> None:
+        """Give moving disc ``i`` (caller's numbering) velocity ``(vx, vy)`` at ``time``, and ``position`` if given.
+
+        Its path restarts at ``time``; its collision counter moves on, so every event predicted against it
+        is stale; it changes cell if its position did; and it alone is re-predicted (its prediction scans
+        every neighbour, and any other disc's pending event stays valid or is stale).
+        ``position`` must lie in the box (wrapped); the caller has checked the disc fits there.
+        """
+        k = i if self._rank is None else int(self._rank[i])
+        t = self.time - self._epoch
+        offset = k * _RECORD_BYTES
+        xi, yi, vxi, vyi, ti, ri = _RECORD.unpack_from(self._disc, offset)
+        if position is None:
+            dt = t - ti
+            xi += vxi * dt
+            yi += vyi * dt
+        else:
+            xi, yi = float(position[0]), float(position[1])
+            cell = int(self.grid.cells_of(np.array([[xi, yi]]))[0])
+            if cell != self._where[k][_CELL_INDEX]:
+                self._move(k, cell)
+        _RECORD.pack_into(self._disc, offset, xi, yi, float(vx), float(vy), t, ri)
+        self._count[k] += 1
+        self._predict(k, t, -1)
+        self.max_queue = max(self.max_queue, len(self._queue))
+
+    def _move(self, k: int, cell: int) -> None:
+        """Move disc ``k`` (internal numbering) from its cell to ``cell``, in every ghost copy too."""
+        here = self._where[k]
+        tile, slot = here[1], here[_SLOT]
+        others = tuple(m for m in tile[slot] if m != k)
+        tile[slot] = others
+        for tile, slot in here[_GHOSTS]:
+            tile[slot] = others
+        here = self._where[k] = self._cell_info[cell]
+        tile, slot = here[1], here[_SLOT]
+        others = tile[slot] + (k,)
+        tile[slot] = others
+        for tile, slot in here[_GHOSTS]:
+            tile[slot] = others
 
     # --- cheap reads -----------------------------------------------------------------------
     def counts(self) -> dict[str, int]:

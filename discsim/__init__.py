@@ -15,6 +15,7 @@ The public API::
 
 from discsim import scenarios
 from discsim.analysis.compare import Comparison, compare
+from discsim.analysis.contacts import Contact, Contacts, contacts
 from discsim.analysis.dynamics import free_times, msd, vacf
 from discsim.analysis.frames import Frames, frames
 from discsim.analysis.structure import psi6, rdf
@@ -70,6 +71,8 @@ __all__ = [
     "CheckpointError",
     "Checkpointer",
     "Comparison",
+    "Contact",
+    "Contacts",
     "Discs",
     "DiscsimError",
     "Event",
@@ -102,6 +105,7 @@ __all__ = [
     "checkpoint_info",
     "compare",
     "compressibility_factor",
+    "contacts",
     "enskog_collision_rate",
     "enskog_diffusion",
     "frames",

@@ -211,7 +211,7 @@ class Engine(ABC):
         Example:
             >>> import discsim as ds
             >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[0.0, 0.0], [0.0, 0.0]], 1.0), ds.Box(10, 10))
-            >>> sim.set_velocities([0], [[1.0, 0.0]]).run(until=5.0).velocities.tolist()
+            >>> sim.set_velocities([0], [[1.0, 0.0]]).run(until=4.5).velocities.tolist()
             [[0.0, 0.0], [1.0, 0.0]]
         """
         idx = self._disc_indices(indices)
@@ -406,6 +406,10 @@ class Engine(ABC):
         """
         from discsim.run.driver import drive
 
+        if self._handlers:  # sim.on(...): one event (or frame) at a time, callbacks after each
+            from discsim.run.handlers import EventHandlers
+
+            observers = [*(observers or ()), EventHandlers(self._handlers)]
         drive(
             self,
             until=until,

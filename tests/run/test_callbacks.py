@@ -1,0 +1,78 @@
+"""sim.on("collision" | "wall" | "segment", fn) (issue 19, part 2): callbacks that may change the run."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim.events import SET
+
+
+def test_a_game_scores_and_stops_each_hit_target(every_backend):
+    # A striker (0) at the bottom, three targets on its line; each hit target is stopped dead and scored.
+    discs = ds.Discs([[5.0, 1.0], [5.0, 4.0], [5.0, 6.5], [5.0, 9.0]], [[0.0, 1.0], [0, 0], [0, 0], [0, 0]], 0.5)
+    sim = ds.EventDriven(discs, ds.Box(10.0, 10.0))
+    score, seen = [], []
+
+    def hit(sim, contact):
+        seen.append((contact.time, sim.time, sim.velocities.copy()))
+        target = contact.j if contact.i == 0 else contact.i
+        score.append(target)
+        sim.set_velocities([target], [[0.0, 0.0]])
+
+    sim.on("collision", hit).run(until=30.0)
+    sim._check()
+    assert score[:1] == [1]
+    assert all(t == now for t, now, _ in seen)  # each callback sees the state right after its event
+    assert (sim.events["kind"] == SET).sum() == len(score)
+    # The log stays exact: positions rebuilt after every change match a replay of the recorded log.
+    times = np.linspace(0.0, 30.0, 31)
+    path = sim.trajectory(times)
+    np.testing.assert_allclose(path[-1], sim.positions, atol=1e-9)
+
+
+def test_callbacks_change_nothing_when_they_only_look(every_backend):
+    discs, box = ds.random_gas(100, 0.3, periodic=False, seed=4)
+    plain = ds.EventDriven(discs, box).run(until=2.0)
+    kinds = []
+    watched = ds.EventDriven(discs, box)
+    watched.on("collision", lambda sim, c: kinds.append(c.kind)).on("wall", lambda sim, c: kinds.append(c.kind))
+    watched.run(until=2.0)
+    assert plain.events.tobytes() == watched.events.tobytes()
+    assert len(kinds) == len(plain.events)
+    c = ds.contacts(plain)
+    assert kinds == c.kind.tolist()
+
+
+def test_contact_data_in_the_callback_match_contacts(every_backend):
+    discs, box = ds.random_gas(60, 0.3, periodic=True, seed=5)
+    got = []
+    sim = ds.EventDriven(discs, box).on("collision", lambda sim, c: got.append(c)).run(until=1.0)
+    c = ds.contacts(sim)
+    assert len(got) == len(c)
+    np.testing.assert_array_equal([g.impulse for g in got], c.impulse)
+    np.testing.assert_array_equal([g.normal for g in got], c.normal)
+
+
+def test_segment_callback_and_fixed_step(every_backend):
+    seg = ds.Segment([6.0, 0.0], [6.0, 10.0])
+    discs = ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], radii=0.5)
+    hits = []
+    ds.EventDriven(discs, ds.Box(10.0, 10.0), segments=[seg]).on("segment", lambda s, c: hits.append(c.time)).run(
+        until=5.0
+    )
+    assert hits == [3.5]
+    walls = []
+    pit = ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=0.25)
+    pit.on("wall", lambda s, c: (walls.append(c.surface), s.apply_impulse([0], [0.0, 1.0]))).run(until=20.0)
+    assert walls[:2] == [-2, -4]  # right wall, then (pushed up by 1) the top before the left
+
+
+@pytest.mark.parametrize("kind", ["collisions", "crossing", "set", 3, None])
+def test_unknown_kinds_are_refused(kind):
+    sim = ds.EventDriven(*ds.random_gas(10, 0.2, seed=1))
+    with pytest.raises(ds.InvalidArgumentError, match=repr(kind)):
+        sim.on(kind, print)
+    with pytest.raises(ds.InvalidArgumentError, match="callable"):
+        sim.on("wall", 3)

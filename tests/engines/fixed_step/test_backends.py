@@ -172,6 +172,18 @@ def test_the_compiled_wrap_and_minimum_image_are_the_boxs(size):
     assert np.array([_image(v, size) for v in values.tolist()]).tobytes() == image.tobytes()
 
 
+@needs_numba
+def test_the_compiled_sort_of_the_overlapping_pairs_is_numpys():
+    from discsim.engines.fixed_step.numba.kernels import _heapsort
+
+    rng = np.random.default_rng(2)
+    for m in (0, 1, 2, 3, 10, 257, 5000):
+        keys = rng.integers(0, max(m // 2, 1), m + 5)  # duplicates too; the tail past m stays as it is
+        expected = np.concatenate([np.sort(keys[:m]), keys[m:]])
+        _heapsort(keys, m)
+        assert keys.tolist() == expected.tolist()
+
+
 # --- checkpoints move between backends -----------------------------------------------------------------
 @needs_numba
 @pytest.mark.parametrize(("first", "second"), [("python", "numba"), ("numba", "python")])

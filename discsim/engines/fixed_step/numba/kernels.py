@@ -194,8 +194,11 @@ def _grow(ev_n, ev_f, need):
     size = max(need, 2 * len(ev_n))
     new_n = np.empty((size, 3), dtype=np.int64)
     new_f = np.empty((size, 8))
-    new_n[: len(ev_n)] = ev_n
-    new_f[: len(ev_f)] = ev_f
+    for k in range(len(ev_n)):  # loops, not slice assignments: they compile in a fraction of the time
+        for c in range(3):
+            new_n[k, c] = ev_n[k, c]
+        for c in range(8):
+            new_f[k, c] = ev_f[k, c]
     return new_n, new_f
 
 
@@ -205,7 +208,8 @@ def _log_wall(ev_n, ev_f, k, frame, i, x, y, vx, vy):
     ev_n, ev_f = _grow(ev_n, ev_f, k + 1)
     ev_n[k, 0], ev_n[k, 1], ev_n[k, 2] = frame, i, -1
     ev_f[k, 0], ev_f[k, 1], ev_f[k, 2], ev_f[k, 3] = x, y, vx, vy
-    ev_f[k, 4:] = math.nan
+    for c in range(4, 8):
+        ev_f[k, c] = math.nan
     return ev_n, ev_f
 
 
@@ -419,7 +423,8 @@ def _push(keys, m, key):
     """``keys`` with ``key`` at index ``m`` (copied into a larger array when full)."""
     if m == len(keys):
         grown = np.empty(2 * m, dtype=np.int64)
-        grown[:m] = keys
+        for p in range(m):
+            grown[p] = keys[p]
         keys = grown
     keys[m] = key
     return keys
@@ -438,7 +443,31 @@ def _overlaps(pos, radii, li, lj, all_pairs, periodic, width, height, group, blo
         keys = np.empty(len(li), dtype=np.int64)
         m, overlap = _overlaps_listed(keys, pos, radii, li, lj, periodic, width, height, overlap)
         tests = len(li)
-    return np.sort(keys[:m]), tests, overlap
+    _heapsort(keys, m)
+    return keys[:m], tests, overlap
+
+
+@jit
+def _sift(keys, root, end):
+    """Move ``keys[root]`` down the max-heap ``keys[:end]`` to its place."""
+    while 2 * root + 1 < end:
+        child = 2 * root + 1
+        if child + 1 < end and keys[child] < keys[child + 1]:
+            child += 1
+        if keys[root] >= keys[child]:
+            return
+        keys[root], keys[child] = keys[child], keys[root]
+        root = child
+
+
+@jit
+def _heapsort(keys, m):
+    """Sort ``keys[:m]`` in place (ints: the order ``np.sort`` gives; written out, it compiles 10x faster)."""
+    for root in range(m // 2 - 1, -1, -1):
+        _sift(keys, root, m)
+    for end in range(m - 1, 0, -1):
+        keys[0], keys[end] = keys[end], keys[0]
+        _sift(keys, 0, end)
 
 
 @jit

@@ -279,7 +279,10 @@ class FixedStep(Engine):
         if settings["policy"] not in POLICIES or settings["broad_phase"] not in BROAD_PHASES:
             msg = f"unknown policy {settings['policy']!r} or broad phase {settings['broad_phase']!r}"
             raise CheckpointError(msg)
-        backend = _choose_backend(settings.get("backend", "auto"), settings["policy"])
+        backend = settings.get("backend", "auto")
+        if settings["policy"] not in COMPILED_POLICIES:  # no compiled frame: every backend runs it in Python
+            backend = "python"
+        backend = _choose_backend(backend, settings["policy"])
         sim._configure(
             scene,
             settings["record"],

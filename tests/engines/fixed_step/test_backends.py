@@ -210,6 +210,14 @@ def test_a_checkpoint_of_the_compiled_frame_loads_where_numba_is_missing(tmp_pat
     assert_identical(whole, copy.run(frames=40))
 
 
+@needs_numba
+def test_a_sub_frame_run_loads_under_numba_in_python(tmp_path):
+    discs, box = ds.random_gas(40, 0.3, seed=4)
+    sim = ds.FixedStep(discs, box, dt=0.05, policy="bisect").run(frames=10)
+    copy = ds.load(sim.save(tmp_path / "bisect.dsc"), backend="numba")
+    assert copy.backend == "python" and copy.run(frames=10).frames == 20
+
+
 # --- the choice of backend -------------------------------------------------------------------------------
 def test_auto_takes_numba_when_it_imports_and_the_policy_has_a_compiled_frame(monkeypatch):
     discs, box = ds.random_gas(30, 0.3, seed=1)

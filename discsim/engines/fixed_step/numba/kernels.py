@@ -9,9 +9,12 @@ order as :func:`discsim.cells.neighbour_pairs` gives its pairs, so the exported 
 Python's ``math.hypot`` (used by ``"separate"``) is not the C library's ``hypot``: :func:`cpython_hypot`
 is CPython's own algorithm, so the two agree to the last bit.
 
+:func:`frames` does a batch of frames in one call (a run's frames cost no interpreter time between them).
 Every function is ``njit(cache=True)`` (no fastmath: it would reorder the floating-point operations); the
-first process compiles them (seconds) and writes the machine code to ``__pycache__``; later processes load
-it. Without numba the functions stay plain Python: importable (for doctests) and correct, only slow.
+first process compiles them (about 10 s of CPU) and writes the machine code to ``__pycache__``; later
+processes load it (about half a second). Without numba the functions stay plain Python: importable (for
+doctests) and correct, only slow. The hot loops reassign no array and call no function that takes one:
+either costs reference counts on every pass.
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ else:
     # tested (or that cannot vanish), as the Python frame does.
     jit = _nb.njit(cache=True, error_model="numpy")
 
-#: The compiled policies by name: the ``policy`` argument of :func:`frame`.
+#: The compiled policies by name: the ``policy`` argument of :func:`frames`.
 POLICY_CODES = {"resolve": 0, "revert": 1, "separate": 2}
 RESOLVE, REVERT, SEPARATE = 0, 1, 2
 INF = math.inf

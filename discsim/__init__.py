@@ -21,6 +21,7 @@ from discsim.analysis.frames import Frames, frames
 from discsim.analysis.structure import psi6, rdf
 from discsim.analysis.theory import enskog_collision_rate, enskog_diffusion, henderson_z, speed_cdf, speed_pdf
 from discsim.analysis.thermo import compressibility_factor, thermo
+from discsim.engines.compress import CompressionReport, compress
 from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import POLICIES, FixedStep, FixedStepState
 from discsim.errors import (
@@ -71,6 +72,7 @@ __all__ = [
     "CheckpointError",
     "Checkpointer",
     "Comparison",
+    "CompressionReport",
     "Contact",
     "Contacts",
     "Discs",
@@ -104,6 +106,7 @@ __all__ = [
     "billiard_break",
     "checkpoint_info",
     "compare",
+    "compress",
     "compressibility_factor",
     "contacts",
     "enskog_collision_rate",

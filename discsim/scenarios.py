@@ -91,8 +91,10 @@ def random_gas(
     temperature: float = 1.0,
     radius: float = 1.0,
     mass: float = 1.0,
+    radii=None,
+    fractions=None,
 ):
-    """A gas of ``n`` equal discs in a square box at a given packing fraction.
+    """A gas of ``n`` discs (equal, or of several sizes) in a square box at a given packing fraction.
 
     Discs start on randomly occupied, randomly jittered sites of a triangular
     lattice (so even dense gases start without overlaps), with Gaussian
@@ -106,7 +108,15 @@ def random_gas(
         periodic: periodic box (True) or reflecting walls.
         seed: seed of ``numpy.random.default_rng``; the same seed gives the same gas.
         temperature: ``kT`` in energy units (positive, finite).
-        radius: disc radius (length units). mass: disc mass (positive, finite).
+        radius: disc radius (length units). mass: disc mass (positive, finite), the same for every disc.
+        radii: None for equal discs of ``radius``; or the radii of several species, e.g. ``[1.0, 1.4]``,
+            mixed in ``fractions`` (default equal; the counts are rounded to sum to ``n``) and shuffled, with
+            each disc's species as its group; or an array of ``n`` radii; or a size distribution, a callable
+            ``f(rng, n)`` returning ``n`` radii (e.g. ``lambda rng, n: rng.uniform(0.8, 1.2, n)``). The
+            discs sit on a lattice spaced for the largest, so a mixture starts up to
+            ``max(r)^2 / mean(r^2)`` times less dense than a monodisperse gas can: compress it from there
+            (``ds.compress``).
+        fractions: the share of each species in ``radii`` (positive, normalised here).
 
     Returns:
         ``(discs, box)``.
@@ -135,7 +145,13 @@ def random_gas(
             msg = f"{name} must be positive and finite, got {value!r}"
             raise InvalidArgumentError(msg)
     rng = np.random.default_rng(seed)
-    side = math.sqrt(n * math.pi * radius**2 / packing_fraction)
+    groups = None
+    if radii is not None:
+        sizes, groups = _radii(n, radii, fractions, rng)
+        radius = float(sizes.max())
+        side = math.sqrt(math.pi * float(np.sum(sizes**2)) / packing_fraction)
+    else:
+        side = math.sqrt(n * math.pi * radius**2 / packing_fraction)
     if periodic and side < 6.0 * radius:  # the engines' cell grid needs 3 diameters a side
         need = math.ceil(36.0 * packing_fraction / math.pi)
         msg = (
@@ -165,13 +181,57 @@ def random_gas(
         positions = Box(side, side, periodic=True).wrap(positions)  # np.mod alone can give the far edge
     else:
         positions = np.clip(positions, radius, side - radius)
+    if radii is not None:
+        radius = sizes
     velocities = rng.normal(0.0, math.sqrt(temperature / mass), size=(n, 2))
     if n > 1:
         velocities -= velocities.mean(axis=0)
     energy = 0.5 * mass * float(np.sum(velocities**2))
     if energy > 0:
         velocities *= math.sqrt(n * temperature / energy)
-    return Discs(positions, velocities, radius, mass), Box(side, side, periodic=periodic)
+    return Discs(positions, velocities, radius, mass, groups), Box(side, side, periodic=periodic)
+
+
+def _radii(n: int, radii, fractions, rng: np.random.Generator):
+    """The ``(n,)`` radii of :func:`random_gas` and their groups (species index, or None), checked."""
+    if callable(radii):
+        sizes = np.asarray(radii(rng, n), dtype=float)
+        if sizes.shape != (n,):
+            msg = f"the size distribution radii(rng, n) must return {n} radii, got shape {sizes.shape}"
+            raise InvalidArgumentError(msg)
+        groups = None
+    else:
+        try:
+            values = np.asarray(radii, dtype=float)
+        except (TypeError, ValueError):
+            msg = f"radii must be a list of species radii, an array of n radii or a callable, got {radii!r}"
+            raise InvalidArgumentError(msg) from None
+        if values.ndim != 1 or len(values) == 0:
+            msg = f"radii must be a list of species radii, an array of n radii or a callable, got {radii!r}"
+            raise InvalidArgumentError(msg)
+        if fractions is None and len(values) == n and n > 1:
+            sizes, groups = values, None  # one radius per disc
+        else:
+            shares = np.full(len(values), 1.0 / len(values)) if fractions is None else np.asarray(fractions, float)
+            if (
+                shares.shape != values.shape
+                or not (np.isfinite(shares).all() and (shares >= 0).all())
+                or not (shares.sum() > 0)
+            ):
+                msg = f"fractions must be {len(values)} non-negative numbers, not all 0, got {fractions!r}"
+                raise InvalidArgumentError(msg)
+            exact = shares / shares.sum() * n
+            counts = np.floor(exact).astype(np.int64)
+            order = np.argsort(-(exact - counts), kind="stable")  # largest remainders first
+            counts[order[: n - int(counts.sum())]] += 1
+            groups = rng.permutation(np.repeat(np.arange(len(values)), counts))
+            sizes = values[groups]
+    bad = ~(np.isfinite(sizes) & (sizes > 0))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        msg = f"radius {sizes[i]!r} (disc {i}) must be positive and finite"
+        raise InvalidArgumentError(msg)
+    return sizes, groups
 
 
 # --- set pieces: the study's four PIT failures and classic demonstrations -------------------------------

@@ -393,10 +393,27 @@ def _cmd_run(args) -> int:
     except KeyboardInterrupt:
         print(f"\ndiscsim run: interrupted; continue with the same command and --resume (from {out})", file=sys.stderr)
         return 130
+    except OSError as exc:  # a full disk, say: the last checkpoint is whole (files are replaced atomically)
+        print(f"discsim run: {_os_problem(exc, out)}", file=sys.stderr)
+        return 1
     summary = _run_summary(sim, args, e0, collisions0, seconds, files)
-    _write_json(files["summary"], summary)
+    try:
+        _write_json(files["summary"], summary)
+    except OSError as exc:
+        print(f"discsim run: {_os_problem(exc, out)}", file=sys.stderr)
+        return 1
     _print_run_summary(summary, resumed)
     return 0
+
+
+def _os_problem(exc: OSError, out: Path) -> str:
+    """One line on a failed write: what failed, where, and how to go on."""
+    what = exc.strerror or str(exc) or type(exc).__name__
+    where = f" ({exc.filename})" if exc.filename else ""
+    return (
+        f"cannot write to {out}: {what}{where}; the last checkpoint there is intact: make room and continue "
+        "with the same command and --resume"
+    )
 
 
 # --- view ------------------------------------------------------------------------------------------------

@@ -380,6 +380,38 @@ def read_stream(path, *, partial: bool = False) -> RecordStream:
     return RecordStream(meta, arrays, records, len(pieces) - 1, end, last)
 
 
+def _verify_chunks(handle, path: Path, dtype: np.dtype, position: int, end: int, records: int) -> None:
+    """Check every chunk from byte ``position`` (after the header) to ``end``: checksums, order, ``records`` in all.
+
+    Raises:
+        CheckpointError: naming the first damaged chunk and how many records before it are intact.
+    """
+    expected, start = 0, position
+    handle.seek(position)
+    while position < end:
+        try:
+            block = _read_block(handle, str(path), end)
+        except CheckpointError as exc:
+            msg = (
+                f"{path}: damaged before byte {end}, where the checkpoint says the log ends: {exc}. The "
+                f"{expected} records before byte {position} are intact. Nothing was appended; stream to a new file "
+                "(record_to=another path) to go on"
+            )
+            raise CheckpointError(msg) from exc
+        if block is None:
+            break
+        meta, arrays, position = block
+        got = arrays.get("records")
+        if got is None or got.dtype != dtype or got.ndim != 1 or meta.get("first") != expected:
+            msg = f"{path}: the chunk ending at byte {position} does not follow the one before it (damaged log)"
+            raise CheckpointError(msg)
+        expected += len(got)
+    if expected != records:
+        msg = f"{path}: holds {expected} records up to byte {end}, but the checkpoint saw {records} (damaged log)"
+        raise CheckpointError(msg)
+    handle.seek(start)  # where the caller left it
+
+
 class RecordWriter:
     """Appends chunks of records to a stream file; see the module docstring for the layout.
 
@@ -421,15 +453,17 @@ class RecordWriter:
         return cls(handle, path, dtype, 0, len(data))
 
     @classmethod
-    def reopen(cls, path, records: int, end: int, expect: dict | None = None) -> RecordWriter:
+    def reopen(cls, path, records: int, end: int, expect: dict | None = None, verify: bool = True) -> RecordWriter:
         """Continue a stream known to hold ``records`` records in its first ``end`` bytes.
 
         Checks the header against ``expect`` (items its JSON dict must hold),
-        that chunk boundaries lead exactly to byte ``end``, and that the chunk
-        ending there is intact and ends at record ``records``; only then cuts
-        off whatever follows (chunks written after the checkpoint that
-        recorded ``records`` and ``end``, possibly half a chunk from a killed
-        run).
+        that chunk boundaries lead exactly to byte ``end``, and that every chunk
+        up to there is intact (its checksum), follows the one before and that
+        they end at record ``records`` (``verify=False``: only the last chunk, for
+        a file verified a moment ago); only then cuts off whatever follows
+        (chunks written after the checkpoint that recorded ``records`` and
+        ``end``, possibly half a chunk from a killed run). Appending after a
+        damaged chunk would make the whole file unreadable.
 
         Raises:
             FileNotFoundError: if the file is missing.
@@ -450,8 +484,10 @@ class RecordWriter:
             if size < end:
                 msg = f"{path}: truncated: holds {size} bytes but the checkpoint saw {end}"
                 raise CheckpointError(msg)
+            if verify:
+                _verify_chunks(handle, path, dtype, position, end, records)
             last_start = None
-            while position < end:  # follow the length fields; verify only the last chunk
+            while position < end:  # follow the length fields to the last chunk
                 raw = handle.read(_LENGTH.size)
                 if len(raw) < _LENGTH.size:
                     break

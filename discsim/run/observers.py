@@ -158,9 +158,14 @@ class EventStream(Observer):
             raise CheckpointError(msg)
         missed = logged - stream["base"] - stream["records"] - len(engine._log)
         if missed:
+            why = (
+                f"writing them failed: {stream['write_error']}"
+                if stream.get("write_error")
+                else "they ran without record_to and record=False"
+            )
             msg = (
-                f"{self.path}: the log on disk stops {missed} events before the engine (they ran without "
-                "record_to and record=False); stream to a new file instead"
+                f"{self.path}: the log on disk stops {missed} events before the engine ({why}); continue from "
+                "the last checkpoint (discsim.resume), or stream to a new file"
             )
             raise CheckpointError(msg)
         # Opening checks the file's own header against this run (a foreign or damaged file is refused).
@@ -171,8 +176,12 @@ class EventStream(Observer):
     def start(self, engine, plan) -> None:
         stream, logged = engine._stream, engine._event_count()
         if stream is not None and self.path.exists():
-            self._writer = RecordWriter.reopen(
-                self.path, stream["records"], stream["end"], expect={"run_id": stream["run_id"], "base": stream["base"]}
+            self._writer = RecordWriter.reopen(  # check() has just verified every chunk
+                self.path,
+                stream["records"],
+                stream["end"],
+                expect={"run_id": stream["run_id"], "base": stream["base"]},
+                verify=False,
             )
             engine._stream = {**stream, "path": str(self.path.absolute())}
             self._hold(engine._log.since(0))  # recorded since the last flush
@@ -213,8 +222,12 @@ class EventStream(Observer):
     def flush(self, engine) -> None:
         """Write the events held as one chunk, stamped with the time it covers up to."""
         records = np.concatenate(self._pending) if self._pending else np.zeros(0, dtype=EVENT_DTYPE)
-        self._writer.append(records, {"time": engine.time if self._time is None else self._time})
         self._pending, self._held = [], 0
+        try:
+            self._writer.append(records, {"time": engine.time if self._time is None else self._time})
+        except OSError as exc:  # a full disk, say: these events are lost to the log; say so if asked again
+            engine._stream = {**engine._stream, "write_error": f"{type(exc).__name__}: {exc}"}
+            raise
         engine._stream = {**engine._stream, "records": self._writer.records, "end": self._writer.end}
 
     def sync(self) -> None:

@@ -47,7 +47,15 @@ def instructions(tree: Path, n: int, packing: float, collisions: int, scratch: P
     """Total instructions (callgrind's ``I refs``) of one probe run of ``tree`` with ``collisions`` timed."""
     workdir = scratch / "cwd"
     workdir.mkdir(parents=True, exist_ok=True)
-    env = dict(os.environ, PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(scratch / "pycache"), PYTHONHASHSEED="0")
+    # DISCSIM_NO_NUMBA: trees with a compiled backend run their pure-Python loop, which is what is compared
+    # (older trees ignore the variable).
+    env = dict(
+        os.environ,
+        PYTHONPATH=str(tree),
+        PYTHONPYCACHEPREFIX=str(scratch / "pycache"),
+        PYTHONHASHSEED="0",
+        DISCSIM_NO_NUMBA="1",
+    )
     args = [str(tree), str(n), repr(packing), "1", str(warmup_collisions(n)), str(collisions)]
     # Compile the bytecode first, outside the count, so that no counted run pays for it.
     subprocess.run([sys.executable, "-c", "import discsim"], cwd=workdir, env=env, check=True)

@@ -116,7 +116,15 @@ def measure(tree: Path, n: int, packing: float, seed: int, collisions: int, scra
     """
     workdir = scratch / "cwd"
     workdir.mkdir(exist_ok=True)
-    env = dict(os.environ, PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(scratch / "pycache"), PYTHONHASHSEED="0")
+    # DISCSIM_NO_NUMBA: trees with a compiled backend run their pure-Python loop, which is what is compared
+    # (older trees ignore the variable).
+    env = dict(
+        os.environ,
+        PYTHONPATH=str(tree),
+        PYTHONPYCACHEPREFIX=str(scratch / "pycache"),
+        PYTHONHASHSEED="0",
+        DISCSIM_NO_NUMBA="1",
+    )
     args = [str(tree), str(n), repr(packing), str(seed), str(warmup_collisions(n)), str(collisions)]
     done = subprocess.run(
         [sys.executable, "-c", _PROBE, *args], cwd=workdir, env=env, capture_output=True, text=True, check=False

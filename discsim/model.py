@@ -72,13 +72,38 @@ def _readonly(array: np.ndarray) -> np.ndarray:
     return array
 
 
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _real_array(name: str, value, error=InvalidDiscsError) -> np.ndarray:
+    """``value`` as a fresh float64 array, refusing what numpy would turn into numbers by guessing.
+
+    Complex numbers (numpy drops the imaginary part with only a warning), strings, bools, ``None`` and other
+    objects, and ragged lists raise ``error`` naming ``name`` and the value.
+    """
+    try:
+        raw = np.asarray(value, dtype=object if isinstance(value, (str, bytes)) else None)
+    except (TypeError, ValueError) as exc:  # ragged
+        msg = f"{name} must be an array of real numbers, got a ragged {_short(value)}"
+        raise error(msg) from exc
+    if raw.dtype.kind == "O":
+        real = (int, float, np.integer, np.floating)
+        bad = [x for x in raw.reshape(-1).tolist() if not isinstance(x, real) or isinstance(x, bool)]
+        if bad:
+            msg = f"{name} must be real numbers, got {_short(bad[0])} in {_short(value)}"
+            raise error(msg)
+    elif raw.dtype.kind not in "iuf":
+        kind = {"c": "complex numbers", "b": "booleans", "U": "strings", "S": "bytes"}.get(raw.dtype.kind, raw.dtype)
+        msg = f"{name} must be real numbers, got {kind}: {_short(value)}"
+        raise error(msg)
+    return np.array(raw, dtype=np.float64)
+
+
 def _as_float_array(name: str, value, shape: tuple[int, ...]) -> np.ndarray:
     """Return ``value`` as a fresh float64 array of ``shape`` (scalars broadcast)."""
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        msg = f"{name} must be numeric, got {value!r}"
-        raise InvalidDiscsError(msg) from exc
+    array = _real_array(name, value)
     if array.ndim == 0 and len(shape) == 1:
         return np.full(shape, float(array))
     if array.shape != shape:
@@ -118,7 +143,7 @@ class Discs:
     """
 
     def __init__(self, positions, velocities, radii, masses=1.0, groups=None):
-        pos = np.array(positions, dtype=np.float64)
+        pos = _real_array("positions", positions)
         if pos.ndim != 2 or pos.shape[1] != 2:
             msg = f"positions must have shape (N, 2), got shape {pos.shape}"
             raise InvalidDiscsError(msg)
@@ -154,11 +179,19 @@ class Discs:
         if groups is None:
             grp = np.zeros(n, dtype=np.int64)
         else:
-            grp = np.array(groups)
+            try:
+                grp = np.array(groups)
+            except (TypeError, ValueError) as exc:
+                msg = f"groups must be ({n},) integers, got {_short(groups)}"
+                raise InvalidDiscsError(msg) from exc
             if grp.ndim == 0:
                 grp = np.full(n, grp)
-            if grp.shape != (n,) or not np.issubdtype(grp.dtype, np.integer):
-                msg = f"groups must be ({n},) integers, got shape {grp.shape} dtype {grp.dtype}"
+            if grp.shape != (n,) or not np.issubdtype(grp.dtype, np.integer) or grp.dtype == np.bool_:
+                msg = f"groups must be ({n},) integers, got shape {grp.shape} dtype {grp.dtype}: {_short(groups)}"
+                raise InvalidDiscsError(msg)
+            if grp.dtype == np.uint64 and (grp > np.iinfo(np.int64).max).any():  # they would wrap to negatives
+                i = int(np.flatnonzero(grp > np.iinfo(np.int64).max)[0])
+                msg = f"disc {i} has group label {int(grp[i])}, above the largest label 2**63 - 1"
                 raise InvalidDiscsError(msg)
             grp = grp.astype(np.int64)
         self.positions = _readonly(pos)
@@ -316,8 +349,8 @@ class Segment:
     __slots__ = ("p0", "p1")
 
     def __init__(self, p0, p1):
-        a = np.array(p0, dtype=np.float64)
-        b = np.array(p1, dtype=np.float64)
+        a = _real_array("segment p0", p0)
+        b = _real_array("segment p1", p1)
         for name, p in (("p0", a), ("p1", b)):
             if p.shape != (2,) or not np.isfinite(p).all():
                 msg = f"segment {name} must be 2 finite numbers, got {p.tolist()}"
@@ -352,7 +385,10 @@ def polygon(vertices) -> list[Segment]:
         >>> len(polygon([(1, 1), (9, 1), (5, 8)]))
         3
     """
-    v = np.asarray(vertices, dtype=float)
+    v = _real_array("polygon vertices", vertices)
+    if v.ndim != 2 or v.shape[1] != 2 or len(v) < 2:
+        msg = f"polygon vertices must have shape (K, 2) with K >= 2, got shape {v.shape}: {_short(vertices)}"
+        raise InvalidDiscsError(msg)
     return [Segment(v[k], v[(k + 1) % len(v)]) for k in range(len(v))]
 
 
@@ -366,14 +402,19 @@ def normalize_pass_through(pairs) -> frozenset:
         [(1, 2), (3, 3)]
     """
     out = set()
+    if isinstance(pairs, (str, bytes)) or not (pairs is None or hasattr(pairs, "__iter__")):
+        msg = f"pass_through must be a collection of pairs of group labels, got {_short(pairs)}"
+        raise InvalidDiscsError(msg)
     for pair in pairs or ():
         try:
             g1, g2 = pair
         except (TypeError, ValueError) as exc:
             msg = f"pass_through must hold pairs of group labels, got {pair!r}"
             raise InvalidDiscsError(msg) from exc
-        if int(g1) != g1 or int(g2) != g2:
-            msg = f"group labels must be integers, got {pair!r}"
-            raise InvalidDiscsError(msg)
+        for g in (g1, g2):
+            whole = isinstance(g, (int, np.integer)) or (isinstance(g, (float, np.floating)) and float(g).is_integer())
+            if isinstance(g, (bool, np.bool_)) or not whole:
+                msg = f"pass_through group labels must be integers, got {g!r} in {pair!r}"
+                raise InvalidDiscsError(msg)
         out.add((min(int(g1), int(g2)), max(int(g1), int(g2))))
     return frozenset(out)

@@ -137,6 +137,11 @@ def random_gas(
         msg = f"n must be a positive integer, got {n!r}"
         raise InvalidArgumentError(msg)
     n = int(n)
+    if isinstance(packing_fraction, (bool, np.bool_)) or not isinstance(
+        packing_fraction, (int, float, np.integer, np.floating)
+    ):
+        msg = f"packing_fraction must be a number in (0, {_MAX_PACKING}], got {packing_fraction!r}"
+        raise InvalidArgumentError(msg)
     if not (0.0 < packing_fraction <= _MAX_PACKING):
         msg = f"packing fraction {packing_fraction!r} cannot be reached: it must lie in (0, {_MAX_PACKING}]"
         raise PackingError(msg)

@@ -7,6 +7,8 @@ engine and every check uses (:meth:`Scene.passes`).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from discsim.cells import neighbour_pairs
@@ -121,6 +123,11 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
             )
             raise UnitsError(msg)
     pass_through = normalize_pass_through(pass_through)
+    labels = np.unique(discs.groups).tolist()
+    unknown = sorted({g for pair in pass_through for g in pair} - set(labels))
+    if unknown:
+        msg = f"pass_through names group label(s) {unknown} that no disc has (groups: {labels[:20]})"
+        warnings.warn(msg, UserWarning, stacklevel=4)
     check_fits(discs, box, segments=segments, pass_through=pass_through)
     return segments, pass_through
 

@@ -22,13 +22,21 @@ def check_times(times, start: float, end: float, span: str) -> np.ndarray:
     Raises:
         TimeError: naming the first bad time and the ``span`` ("simulated span", "logged span").
     """
-    times = np.atleast_1d(np.asarray(times, dtype=float))
+    try:
+        raw = np.asarray(times, dtype=object if isinstance(times, (str, bytes)) else None)
+    except (TypeError, ValueError):  # ragged
+        raw = np.asarray([None], dtype=object)
+    if raw.dtype.kind not in "iuf" or raw.ndim > 1:
+        shown = repr(times) if len(repr(times)) <= 60 else repr(times)[:57] + "..."
+        msg = f"trajectory times must be a number or a 1-D array of numbers, got {shown}"
+        raise TimeError(msg)
+    times = np.atleast_1d(raw.astype(float))
     if times.size and not np.isfinite(times).all():
         msg = f"trajectory times must be finite, got {times[~np.isfinite(times)][0]!r}"
         raise TimeError(msg)
     tol = 1e-12 * max(1.0, abs(end))
     if times.size and (times.min() < start - tol or times.max() > end + tol):
-        bad = times.min() if times.min() < start - tol else times.max()
+        bad = float(times.min() if times.min() < start - tol else times.max())
         msg = f"trajectory time {bad!r} is outside the {span} [{start!r}, {end!r}]"
         raise TimeError(msg)
     return times

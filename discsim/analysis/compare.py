@@ -18,9 +18,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from discsim.cells import neighbour_pairs
-from discsim.errors import InvalidArgumentError
+from discsim.errors import InvalidArgumentError, WrongTypeError
 from discsim.events import COLLISION, WALL
 from discsim.model import kinetic_energy
+from discsim.trajectory import check_times
 
 __all__ = ["Comparison", "compare"]
 
@@ -371,6 +372,11 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
         (1, 0, 0.1667, 26.57)
     """
     for name, engine in (("truth", truth), ("approx", approx)):
+        if not all(hasattr(engine, a) for a in ("discs", "box", "events", "trajectory", "time", "start_time")):
+            shown = repr(engine) if len(repr(engine)) <= 60 else repr(engine)[:57] + "..."
+            msg = f"compare() needs two runs (EventDriven, FixedStep or alike): {name} is {type(engine).__name__} "
+            msg += shown
+            raise WrongTypeError(msg)
         if not getattr(engine, "record", True):
             msg = f"compare() needs the event log of {name}; build the engine with record=True"
             raise InvalidArgumentError(msg)
@@ -400,6 +406,9 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     dts = [float(getattr(e, "dt", 0.0) or 0.0) for e in (truth, approx)]
     if window is None:
         window = _default_window(truth.discs, max(dts))
+    elif isinstance(window, (bool, str, bytes)) or not isinstance(window, (int, float, np.integer, np.floating)):
+        msg = f"window must be a non-negative number of time units, got {window!r}"
+        raise InvalidArgumentError(msg)
     elif not (window >= 0):
         msg = f"window must be a non-negative number of time units, got {window!r}"
         raise InvalidArgumentError(msg)
@@ -429,8 +438,10 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
             times = np.minimum(start + frame * np.arange(count + 1), horizon)  # k * dt may overshoot by roundoff
         else:
             times = np.linspace(start, horizon, _DEFAULT_SAMPLES)
+    else:
+        asked = check_times(times, start, horizon, "span both runs cover")  # was: dropped silently
+        times = np.minimum(np.maximum(asked, start), horizon)  # within the roundoff check_times allows
     times = np.atleast_1d(np.asarray(times, dtype=float))
-    times = times[(times >= start) & (times <= horizon)]
     pos_t = truth.trajectory(times)
     pos_a = approx.trajectory(times)
     d = truth.box.minimum_image(pos_a - pos_t)

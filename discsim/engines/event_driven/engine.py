@@ -125,6 +125,8 @@ class EventDriven(Engine):
             BoxTooSmallError: if a periodic box has fewer than 3 cells a side.
         """
         n = len(radii)
+        if n == 0 and cell_size is None:  # no disc, no contact distance: a 3 x 3 grid fits any box
+            return CellGrid(box, min(box.width, box.height) / 3.0, max_cells=9, what="a third of the box")
         diameter = 2.0 * float(np.max(radii)) if n else 1.0
         if cell_size is None:
             return CellGrid(box, diameter, max_cells=4 * n + 9)

@@ -22,7 +22,8 @@ class Shapes:
         box: the :class:`~discsim.model.Box`. scene: the :class:`~discsim.scene.Scene`.
         radii ``(N,)`` float array and radius (list of N floats): the radii (length).
         masses (list of N floats, inf for an obstacle). moving (list of N bools): finite mass.
-        diameter: the largest diameter (1 with no discs): the broad phase's cell side.
+        diameter: the largest diameter (a third of the box's shorter side with no discs): the broad phase's
+            cell side.
         max_radius: half of ``diameter``.
         seg_a, seg_b ``(S, 2)``: the segments' end points; seg_ends (list of S tuples
             ``(x0, y0, x1, y1)``): the same as floats.
@@ -34,7 +35,8 @@ class Shapes:
         discs, box = scene.discs, scene.box
         self.scene = scene
         self.box = box
-        self.diameter = 2.0 * float(discs.radii.max()) if len(discs) else 1.0
+        # With no discs any cell will do: a third of the shorter side fits every box (3 cells a side).
+        self.diameter = 2.0 * float(discs.radii.max()) if len(discs) else min(box.width, box.height) / 3.0
         self.max_radius = 0.5 * self.diameter
         self.radii = np.array(discs.radii)
         self.radius = discs.radii.tolist()

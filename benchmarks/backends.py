@@ -24,7 +24,6 @@ environment costs) and then with that cache warm.
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -33,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from benchutils import Column, format_table, machine_summary, median, parse_args, write_csv
+from benchutils import Column, call_fresh, format_table, machine_summary, median, parse_args, write_csv
 
 import discsim as ds
 
@@ -111,24 +110,9 @@ def measure(n: int, packing_fraction: float, mixed: bool, backend: str, collisio
     return row
 
 
-_PROBE = """
-import json, sys
-sys.path.insert(0, sys.argv[1])
-import backends
-print(json.dumps(backends.measure(**json.loads(sys.argv[2]))))
-"""
-
-
 def measure_fresh(**args) -> dict:
     """:func:`measure` in a fresh Python process."""
-    here = str(Path(__file__).resolve().parent)
-    done = subprocess.run(
-        [sys.executable, "-c", _PROBE, here, json.dumps(args)], capture_output=True, text=True, check=False
-    )
-    if done.returncode:
-        msg = f"the timed run {args} failed:\n{done.stderr}"
-        raise RuntimeError(msg)
-    return json.loads(done.stdout.splitlines()[-1])
+    return call_fresh("backends", "measure", **args)
 
 
 def backends_section(points: list[Point], repeats: int, results: Path) -> list[dict]:

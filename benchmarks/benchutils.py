@@ -10,11 +10,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 import csv
+import json
 import math
 import os
 import platform
 import signal
 import statistics
+import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -27,6 +29,7 @@ __all__ = [
     "TimeLimitExceeded",
     "Timing",
     "announce",
+    "call_fresh",
     "format_table",
     "load_average",
     "machine_summary",
@@ -185,6 +188,32 @@ def _csv_value(value):
     if isinstance(value, float):
         return repr(value)
     return "" if value is None else value
+
+
+_FRESH_PROBE = """
+import json, sys
+sys.path.insert(0, sys.argv[1])
+module = __import__(sys.argv[2])
+print(json.dumps(getattr(module, sys.argv[3])(**json.loads(sys.argv[4]))))
+"""
+
+
+def call_fresh(module: str, function: str, **args) -> dict:
+    """``module.function(**args)`` in a fresh Python process (a script of this folder); its JSON result.
+
+    Every timed run of the scripts gets its own interpreter, as a user's run would: in one process a run
+    inherits the heap (and the caches) the runs before it left behind.
+
+    Raises:
+        RuntimeError: with the child's stderr, if it fails.
+    """
+    here = str(Path(__file__).resolve().parent)
+    command = [sys.executable, "-c", _FRESH_PROBE, here, module, function, json.dumps(args)]
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    if done.returncode:
+        msg = f"{module}.{function}({args}) failed in a fresh process:\n{done.stderr}"
+        raise RuntimeError(msg)
+    return json.loads(done.stdout.splitlines()[-1])
 
 
 def peak_resident_mb() -> float:

@@ -24,7 +24,6 @@ first frame takes (compiling, or loading the compiled code), ``process cpu`` the
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import resource
@@ -34,7 +33,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from benchutils import Column, format_table, machine_summary, median, parse_args, timed, write_csv
+from benchutils import Column, call_fresh, format_table, machine_summary, median, parse_args, timed, write_csv
 
 import discsim as ds
 
@@ -91,24 +90,9 @@ def measure(n: int, engine: str, frames: int) -> dict:
     return row
 
 
-_PROBE = """
-import json, sys
-sys.path.insert(0, sys.argv[1])
-import fixed_step_frames
-print(json.dumps(fixed_step_frames.measure(**json.loads(sys.argv[2]))))
-"""
-
-
 def measure_fresh(**args) -> dict:
     """:func:`measure` in a fresh Python process."""
-    here = str(Path(__file__).resolve().parent)
-    done = subprocess.run(
-        [sys.executable, "-c", _PROBE, here, json.dumps(args)], capture_output=True, text=True, check=False
-    )
-    if done.returncode:
-        msg = f"the timed run {args} failed:\n{done.stderr}"
-        raise RuntimeError(msg)
-    return json.loads(done.stdout.splitlines()[-1])
+    return call_fresh("fixed_step_frames", "measure", **args)
 
 
 def _pymunk_missing() -> str:

@@ -460,10 +460,13 @@ def test_streaming_keeps_memory_flat(tmp_path):
     short.stream_chunk = long.stream_chunk = 250
     short_mb = peak(short, events=1500, record_to=tmp_path / "short.dse")
     long_mb = peak(long, events=6000, record_to=tmp_path / "long.dse")
+    memory_short_mb = peak(ds.EventDriven(discs, box), events=1500)
     memory_mb = peak(ds.EventDriven(discs, box), events=6000)
     assert long_mb < 1.0 and long_mb < short_mb + 0.25, (short_mb, long_mb)
     in_memory = 6000 * ds.EVENT_DTYPE.itemsize / 1e6  # the log's rows: 89 bytes an event
-    assert memory_mb > in_memory and memory_mb > 4 * long_mb, (memory_mb, long_mb)
+    grown = memory_mb - memory_short_mb  # 4500 more events kept in memory
+    assert memory_mb > in_memory and grown > 0.75 * 4500 * ds.EVENT_DTYPE.itemsize / 1e6, (memory_mb, grown)
+    assert long_mb - short_mb < 0.25 * grown, (short_mb, long_mb, grown)  # streamed: flat
     assert len(ds.read_events(tmp_path / "long.dse").events) == 6000
 
 

@@ -53,9 +53,16 @@ class Contacts:
     """The contacts of a log, one row per collision or wall hit (arrays of length ``E``).
 
     Attributes:
-        index: each contact's row in the log. time, i, j: as in the log. kind: ``"collision"``, ``"wall"``
-        or ``"segment"`` (strings). point, normal: ``(E, 2)``. impulse, speed: ``(E,)``. surface: ``(E,)``
-        int (see :class:`Contact`).
+        index: each contact's row in the log, ``(E,)``.
+        time: as in the log, ``(E,)``.
+        kind: ``"collision"``, ``"wall"`` or ``"segment"`` (strings), ``(E,)``.
+        i: as in the log, ``(E,)``.
+        j: as in the log, ``(E,)``.
+        point: contact points, ``(E, 2)``.
+        normal: unit normals, ``(E, 2)``.
+        impulse: ``(E,)``.
+        speed: normal approach speeds, ``(E,)``.
+        surface: ``(E,)`` int, as in :class:`Contact`.
     """
 
     index: np.ndarray

@@ -15,11 +15,13 @@ from discsim._numba import numba
 from discsim.engines.compress import loop
 
 _nb = numba()
-if _nb is None:  # pragma: no cover - imported only when numba imports
-    msg = "discsim.engines.compress.compiled needs numba"
-    raise ImportError(msg)
+if _nb is None:  # importable without numba (doctest collection); compress() uses it only when numba imports
 
-_jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+    def _jit(function):
+        return function
+
+else:
+    _jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 _globals = dict(vars(loop))
 for _name in loop.ORDER:
     _source = getattr(loop, _name)

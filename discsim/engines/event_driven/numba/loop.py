@@ -27,13 +27,15 @@ import numpy as np
 from discsim._numba import numba
 
 _nb = numba()
-if _nb is None:  # pragma: no cover - the backend imports this module only when numba imports
-    msg = "discsim.engines.event_driven.numba.loop needs numba"
-    raise ImportError(msg)
+if _nb is None:  # importable without numba (doctest collection); the backend only runs when numba imports
 
-# error_model="numpy": a division by zero gives inf or nan instead of a check on every division; the
-# loop divides only by numbers it has tested, as the Python backend does.
-jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+    def jit(function):
+        return function
+
+else:
+    # error_model="numpy": a division by zero gives inf or nan instead of a check on every division; the
+    # loop divides only by numbers it has tested, as the Python backend does.
+    jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT = 0, 1, 2, 3

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import discsim as ds
+from discsim import _numba
 from discsim.events import SET
 
 
@@ -72,8 +73,8 @@ def test_set_positions_moves_a_disc_and_it_keeps_flying(every_backend):
     np.testing.assert_allclose(sim.trajectory([1.0, 2.0]), [[[2.0, 8.0], [8.0, 8.0]], [[3.0, 8.0], [8.0, 8.0]]])
 
 
+@pytest.mark.skipif(not _numba.available(), reason="numba is not installed or is hidden (the fast extra)")
 def test_both_backends_agree_bit_for_bit_after_changes():
-    pytest.importorskip("numba")
     logs = []
     for backend in ("python", "numba"):
         discs, box = _gas(300)

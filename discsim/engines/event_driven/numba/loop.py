@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from discsim import kernels
 from discsim._numba import numba
 
 _nb = numba()
@@ -170,20 +171,8 @@ def heapify(heap, ht, hpos, ints):
 
 
 # --- geometry ------------------------------------------------------------------------------------------
-@jit
-def time_of_impact(dx, dy, dvx, dvy, sigma):
-    """As :func:`discsim.kernels.time_of_impact`."""
-    b = dx * dvx + dy * dvy
-    if b >= 0.0:
-        return INF
-    c = dx * dx + dy * dy - sigma * sigma
-    if c <= 0.0:
-        return 0.0
-    a = dvx * dvx + dvy * dvy
-    d = b * b - a * c
-    if d <= 0.0:
-        return INF
-    return c / (-b + math.sqrt(d))
+# The kernel itself, compiled: one definition of the time of impact (its callers below are compiled too).
+time_of_impact = jit(kernels.time_of_impact)
 
 
 @jit

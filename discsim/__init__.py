@@ -46,7 +46,9 @@ from discsim.io.streams import StreamedEvents, read_events, trajectory_from_even
 from discsim.io.xyz import read_xyz, write_xyz
 from discsim.model import Box, Discs, Segment, polygon
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
+from discsim.run import tasks
 from discsim.run.samplers import GSDWriter, Sampler
+from discsim.run.sweep import sweep
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
 from discsim.view import View, view  # cheap (no matplotlib); binds ds.view to the function, not the module
 
@@ -130,6 +132,8 @@ __all__ = [
     "speed_cdf",
     "speed_pdf",
     "study_cases",
+    "sweep",
+    "tasks",
     "thermo",
     "trajectory_from_events",
     "vacf",

@@ -12,6 +12,8 @@ Commands:
     run: a long event-driven run of a hard-disc gas with a progress bar,
         periodic checkpoints, a streamed event log and ``--resume``; prints
         collisions, collisions/s, energy drift, pressure and Z at the end.
+    sweep: run a task over a grid of parameters and seeds from a TOML spec, on a local pool or a dask
+        cluster, cached and resumable (:func:`discsim.sweep`); writes the table as CSV (and Parquet).
     view: write a self-contained HTML page that replays a run folder (or event
         log, or checkpoint) exactly in a browser (:func:`discsim.view`).
 """
@@ -472,10 +474,145 @@ def _run_view(args) -> int:
     return 0
 
 
+# --- sweep -----------------------------------------------------------------------------------------------
+
+#: What ``discsim sweep`` writes into ``--out``.
+SWEEP_FILES = {"cache": "cache", "csv": "sweep.csv", "parquet": "sweep.parquet", "failures": "failures.txt"}
+
+
+def _add_sweep_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "sweep",
+        help="run a task over a grid of parameters and seeds (local pool or dask), cached and resumable",
+        description=(
+            "Run the task a TOML spec names over its grid and seeds (see discsim.run.spec for the format) on "
+            "a local process pool, or on a dask cluster with --scheduler. Every finished task is cached in "
+            f"OUT/{SWEEP_FILES['cache']}/: run the same command again after a kill and only the missing tasks "
+            f"run. The table goes to OUT/{SWEEP_FILES['csv']} (and OUT/{SWEEP_FILES['parquet']} when pyarrow is "
+            f"installed); tasks that failed every attempt are listed with their tracebacks in "
+            f"OUT/{SWEEP_FILES['failures']}, and the exit code is then 1."
+        ),
+    )
+    parser.add_argument("spec", help="the sweep's TOML file: task, grid, seeds, root_seed, retries")
+    parser.add_argument("--out", required=True, help="folder for the cache and the table")
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="a dask scheduler's address (e.g. tcp://host:8786), or 'local' for a dask LocalCluster here "
+        "(default: a local process pool, no dask)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="K",
+        help="processes of the local pool or LocalCluster (default: the cores; 0: in this process)",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.set_defaults(func=_run_sweep)
+
+
+def _run_sweep(args) -> int:
+    import warnings
+    from contextlib import ExitStack
+
+    import discsim as ds
+    from discsim.run.spec import read_spec
+
+    out = Path(args.out)
+    try:
+        spec = read_spec(args.spec)
+    except ds.DiscsimError as exc:
+        print(f"discsim sweep: {exc}", file=sys.stderr)
+        return 1
+    with ExitStack() as stack:
+        client = None
+        if args.scheduler is not None:
+            try:
+                from distributed import Client, LocalCluster
+            except ImportError:
+                need = 'discsim sweep: --scheduler needs dask.distributed: pip install "discsim[sweep]"'
+                print(need, file=sys.stderr)
+                return 1
+            if args.scheduler == "local":
+                cluster = LocalCluster(
+                    n_workers=args.workers or None, threads_per_worker=1, processes=True, dashboard_address=None
+                )
+                stack.enter_context(cluster)
+                client = stack.enter_context(Client(cluster))
+            elif args.workers is not None:
+                print("discsim sweep: --workers is for the local pool or --scheduler local", file=sys.stderr)
+                return 2
+            else:
+                try:
+                    client = stack.enter_context(Client(args.scheduler, timeout="30s"))
+                except OSError as exc:
+                    print(f"discsim sweep: cannot reach the scheduler {args.scheduler}: {exc}", file=sys.stderr)
+                    return 1
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # failures are reported below
+                table = ds.sweep(
+                    spec.task,
+                    spec.grid,
+                    seeds=spec.seeds,
+                    root_seed=spec.root_seed,
+                    retries=spec.retries,
+                    client=client,
+                    workers=None if client is not None else args.workers,
+                    cache=out / SWEEP_FILES["cache"],
+                    progress=not args.no_progress,
+                )
+        except ds.Interrupted as exc:
+            print(f"discsim sweep: {exc}; run the same command to finish it", file=sys.stderr)
+            return 130
+        except ds.DiscsimError as exc:
+            print(f"discsim sweep: {exc}", file=sys.stderr)
+            return 1
+    return _write_sweep(table, out)
+
+
+def _write_sweep(table, out: Path) -> int:
+    import os
+
+    info, failures = table.attrs["sweep"], table.attrs["failures"]
+    csv = out / SWEEP_FILES["csv"]
+    tmp = csv.with_name(f".{csv.name}.tmp")
+    table.to_csv(tmp, index=False)
+    os.replace(tmp, csv)
+    written = [str(csv)]
+    try:
+        import pyarrow  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        parquet = out / SWEEP_FILES["parquet"]
+        table.to_parquet(parquet, index=False)
+        written.append(str(parquet))
+    report = out / SWEEP_FILES["failures"]
+    if failures:
+        lines = []
+        for f in failures:
+            lines += [f"{f['params']} seed={f['seed']} ({f['attempts']} attempts): {f['error']}", f["traceback"], ""]
+        report.write_text("\n".join(lines))
+        written.append(str(report))
+    else:
+        report.unlink(missing_ok=True)
+    print(
+        f"discsim sweep: {info['tasks']} tasks ({info['ran']} ran, {info['cached']} from the cache, "
+        f"{info['failed']} failed, {info['retries']} retries) in {info['seconds']:.1f} s on {info['where']}"
+    )
+    print(f"  wrote {', '.join(written)}")
+    for f in failures:
+        print(f"  failed: {f['params']} seed={f['seed']}: {f['error']}", file=sys.stderr)
+    return 1 if failures else 0
+
+
 # --- the parser ------------------------------------------------------------------------------------------
 
 #: One ``_add_<command>_parser`` per command, in the order ``--help`` lists them.
-_COMMANDS = (_add_demo_parser, _add_run_parser, _add_view_parser)
+_COMMANDS = (_add_demo_parser, _add_run_parser, _add_sweep_parser, _add_view_parser)
 
 
 def build_parser() -> argparse.ArgumentParser:

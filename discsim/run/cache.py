@@ -1,0 +1,147 @@
+"""The on-disk cache of a sweep: one JSON file per finished task, addressed by what the task computed.
+
+A task's *key* is the SHA-256 of its identity: the task's name, its parameters, its seed and discsim's
+version (canonical JSON, sorted keys). Its entry, ``<folder>/<key[:2]>/<key>.json``, holds the identity
+beside the result, and is written atomically (a temporary file in the same folder, then ``os.replace``),
+so a sweep killed at any moment leaves only whole entries; one that cannot be read is taken as missing
+and computed again. The folder's manifest, ``discsim-sweep.json``, names the task whose results it holds:
+a folder of another task's results, or one holding files that are no sweep's, is refused before anything
+runs, so two studies never mix their numbers.
+
+Only finished tasks are stored: a failure is run again by the next sweep over the same folder.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+from discsim.errors import InvalidArgumentError
+
+__all__ = ["MANIFEST", "SweepCache", "task_key"]
+
+#: The manifest naming the task a cache folder belongs to.
+MANIFEST = "discsim-sweep.json"
+#: The layout of the folder; a later layout would refuse (or convert) an older one.
+LAYOUT = 1
+
+
+def _canonical(identity: dict) -> str:
+    return json.dumps(identity, sort_keys=True, separators=(",", ":"), allow_nan=True)
+
+
+def task_key(task: str, params: dict, seed: int, version: str) -> str:
+    """The hex SHA-256 that addresses one task's result.
+
+    Example:
+        >>> task_key("m:f", {"a": 1}, 7, "0.1.0") == task_key("m:f", {"a": 1}, 7, "0.1.0")
+        True
+        >>> task_key("m:f", {"a": 1}, 7, "0.1.0") == task_key("m:f", {"a": 1.5}, 7, "0.1.0")
+        False
+    """
+    identity = {"task": task, "params": params, "seed": int(seed), "version": version}
+    return hashlib.sha256(_canonical(identity).encode()).hexdigest()
+
+
+class SweepCache:
+    """A folder of finished tasks' results (see the module docstring).
+
+    Args:
+        folder: the cache folder; created when missing.
+        task: the sweep's task name (``module:qualname``).
+        version: discsim's version (part of every key).
+
+    Raises:
+        InvalidArgumentError: if ``folder`` is a file, holds another task's results (its manifest names
+            another task), or holds files but no manifest.
+    """
+
+    def __init__(self, folder, task: str, version: str):
+        self.folder = Path(folder)
+        self.task = task
+        self.version = version
+        self._check_folder()
+
+    def _check_folder(self) -> None:
+        folder = self.folder
+        if folder.exists() and not folder.is_dir():
+            msg = f"cache={str(folder)!r} is a file, not a folder"
+            raise InvalidArgumentError(msg)
+        manifest = folder / MANIFEST
+        if manifest.is_file():
+            try:
+                owner = json.loads(manifest.read_text())["task"]
+            except (OSError, ValueError, KeyError, TypeError) as exc:
+                msg = f"cache={str(folder)!r}: its manifest {MANIFEST} cannot be read ({exc})"
+                raise InvalidArgumentError(msg) from exc
+            if owner != self.task:
+                msg = (
+                    f"cache={str(folder)!r} holds the results of another sweep's task, {owner!r}, not {self.task!r}: "
+                    f"give this sweep a folder of its own"
+                )
+                raise InvalidArgumentError(msg)
+        elif folder.is_dir() and any(folder.iterdir()):
+            msg = (
+                f"cache={str(folder)!r} holds files but is not a sweep cache (no {MANIFEST}): "
+                f"give the sweep an empty or new folder"
+            )
+            raise InvalidArgumentError(msg)
+
+    def open(self) -> None:
+        """Create the folder and its manifest (when a sweep is about to run)."""
+        self.folder.mkdir(parents=True, exist_ok=True)
+        manifest = self.folder / MANIFEST
+        if not manifest.is_file():
+            self._write(manifest, {"format": "discsim sweep cache", "layout": LAYOUT, "task": self.task})
+
+    def _path(self, key: str) -> Path:
+        return self.folder / key[:2] / f"{key}.json"
+
+    def get(self, params: dict, seed: int) -> dict | None:
+        """The stored entry of a finished task (``result``, ``seconds``, ``attempts``), or None."""
+        key = task_key(self.task, params, seed, self.version)
+        try:
+            entry = json.loads(self._path(key).read_text())
+        except (OSError, ValueError):
+            return None  # missing, or unreadable: computed again and overwritten
+        if not isinstance(entry, dict) or entry.get("key") != key or not isinstance(entry.get("result"), dict):
+            return None
+        return entry
+
+    def put(self, params: dict, seed: int, result: dict, seconds: float, attempts: int) -> None:
+        """Store a finished task's result (atomically)."""
+        key = task_key(self.task, params, seed, self.version)
+        entry = {
+            "key": key,
+            "task": self.task,
+            "params": params,
+            "seed": int(seed),
+            "version": self.version,
+            "result": result,
+            "seconds": float(seconds) if math.isfinite(seconds) else None,
+            "attempts": int(attempts),
+        }
+        path = self._path(key)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._write(path, entry)
+
+    def __len__(self) -> int:
+        """Entries stored (finished tasks of any grid, this task and version or older)."""
+        return sum(1 for _ in self.folder.glob("??/*.json")) if self.folder.is_dir() else 0
+
+    @staticmethod
+    def _write(path: Path, content: dict) -> None:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".json")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(json.dumps(content, separators=(",", ":"), allow_nan=True))  # results keep their order
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise

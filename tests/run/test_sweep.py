@@ -1,0 +1,328 @@
+"""ds.sweep: the same table from a plain loop, the local pool and dask; the cache, resuming, failures, bad input."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sweep_tasks
+from paths import ROOT
+
+import discsim as ds
+from discsim.run.cache import MANIFEST
+from discsim.run.sweep import grid_points, seed_streams
+
+pd = pytest.importorskip("pandas")
+
+TESTS = Path(__file__).resolve().parents[1]
+EOS_GRID = {"packing_fraction": [0.1, 0.4], "n": 80, "equilibrate": 2, "measure": 6, "backend": "python"}
+
+
+def plain_loop(task, grid, seeds, **fixed):
+    """The table a sweep must give, from a plain loop in this process."""
+    rows = []
+    for point in grid_points(grid):
+        for seed in seed_streams(seeds):
+            rows.append({**point, "seed": seed, **task(**point, seed=seed, **fixed), "error": None})
+    return pd.DataFrame(rows)
+
+
+# --- the same table everywhere ---------------------------------------------------------------------------
+
+
+def test_local_pool_and_in_process_equal_a_plain_loop():
+    grid = {"a": [1.0, 2.5, -3.0], "b": [0.0, 1.0]}
+    expected = plain_loop(sweep_tasks.draw, grid, 3)
+    for workers in (0, 2):
+        table = ds.sweep(sweep_tasks.draw, grid, seeds=3, workers=workers)
+        pd.testing.assert_frame_equal(table, expected)
+        assert table.attrs["sweep"]["ran"] == 6 * 3
+    assert list(expected.columns) == ["a", "b", "seed", "sum", "first", "label", "big", "error"]
+
+
+@pytest.mark.slow
+def test_dask_local_cluster_equals_local_pool_and_plain_loop():
+    distributed = pytest.importorskip("distributed")
+    expected = plain_loop(ds.tasks.equation_of_state, EOS_GRID, 2)
+    local = ds.sweep(ds.tasks.equation_of_state, EOS_GRID, seeds=2, workers=2)
+    with (
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        remote = ds.sweep(ds.tasks.equation_of_state, EOS_GRID, seeds=2, client=client, progress=True)
+        assert remote.attrs["sweep"]["where"].startswith("dask at tcp://")
+    pd.testing.assert_frame_equal(local, expected)
+    pd.testing.assert_frame_equal(remote, expected)
+    assert (remote.z > 1.0).all() and remote.error.isna().all()
+
+
+def test_list_of_points_keeps_their_order():
+    points = [{"a": 2.0, "b": 1.0}, {"a": -1.0, "b": 0.5}]
+    table = ds.sweep(sweep_tasks.draw, points, seeds=[4, 9], workers=0)
+    assert table[["a", "b", "seed"]].values.tolist() == [[2.0, 1.0, 4], [2.0, 1.0, 9], [-1.0, 0.5, 4], [-1.0, 0.5, 9]]
+    assert table["sum"].iloc[1] == sweep_tasks.draw(2.0, 1.0, seed=9)["sum"]
+
+
+# --- seeds -------------------------------------------------------------------------------------------------
+
+
+def test_seeds_are_spawned_streams_that_adding_points_or_seeds_does_not_change():
+    children = np.random.SeedSequence(7).spawn(3)
+    assert seed_streams(3, root_seed=7) == [int(c.generate_state(1, np.uint64)[0] >> np.uint64(1)) for c in children]
+    assert seed_streams(5, root_seed=7)[:3] == seed_streams(3, root_seed=7)
+    assert seed_streams(3, root_seed=8) != seed_streams(3, root_seed=7)
+    assert len(set(seed_streams(64))) == 64 and all(0 <= s < 2**63 for s in seed_streams(64))
+    small = ds.sweep(sweep_tasks.draw, {"a": [1.0]}, seeds=2, workers=0)
+    more = ds.sweep(sweep_tasks.draw, {"a": [1.0, 5.0]}, seeds=3, workers=0)
+    pd.testing.assert_frame_equal(more.iloc[:2].reset_index(drop=True), small)
+
+
+# --- the cache ---------------------------------------------------------------------------------------------
+
+
+def test_cache_runs_each_task_once_and_only_new_points(tmp_path):
+    log = tmp_path / "log.txt"
+    cache = tmp_path / "cache"
+    first = ds.sweep(sweep_tasks.logged, {"a": [1, 2], "log": str(log)}, seeds=2, workers=2, cache=cache)
+    assert len(log.read_text().splitlines()) == 4 and first.attrs["sweep"]["ran"] == 4
+    again = ds.sweep(sweep_tasks.logged, {"a": [1, 2], "log": str(log)}, seeds=2, workers=2, cache=cache)
+    pd.testing.assert_frame_equal(again, first)
+    assert len(log.read_text().splitlines()) == 4
+    assert again.attrs["sweep"]["cached"] == 4 and again.attrs["sweep"]["ran"] == 0
+    grown = ds.sweep(sweep_tasks.logged, {"a": [1, 2, 3], "log": str(log)}, seeds=2, workers=0, cache=cache)
+    assert len(log.read_text().splitlines()) == 6 and grown.attrs["sweep"]["ran"] == 2
+    pd.testing.assert_frame_equal(grown.iloc[:4], first)
+    manifest = json.loads((cache / MANIFEST).read_text())
+    assert manifest["task"] == "sweep_tasks:logged"
+    assert len(list(cache.glob("??/*.json"))) == 6
+
+
+def test_cache_entry_that_cannot_be_read_is_computed_again(tmp_path):
+    cache = tmp_path / "c"
+    first = ds.sweep(sweep_tasks.draw, {"a": [1.0, 2.0]}, workers=0, cache=cache)
+    entry = sorted(cache.glob("??/*.json"))[0]
+    entry.write_text('{"key": "trunc')
+    again = ds.sweep(sweep_tasks.draw, {"a": [1.0, 2.0]}, workers=0, cache=cache)
+    pd.testing.assert_frame_equal(again, first)
+    assert again.attrs["sweep"]["ran"] == 1 and again.attrs["sweep"]["cached"] == 1
+
+
+def test_version_is_part_of_the_key(tmp_path, monkeypatch):
+    cache = tmp_path / "c"
+    ds.sweep(sweep_tasks.draw, {"a": [1.0]}, workers=0, cache=cache)
+    monkeypatch.setattr(ds, "__version__", "99.0")
+    assert ds.sweep(sweep_tasks.draw, {"a": [1.0]}, workers=0, cache=cache).attrs["sweep"]["ran"] == 1
+
+
+# --- failures ----------------------------------------------------------------------------------------------
+
+
+def test_a_failing_point_is_reported_with_its_traceback_and_the_others_finish():
+    with pytest.warns(RuntimeWarning, match="1 of 4 tasks failed after 3 attempt"):
+        table = ds.sweep(sweep_tasks.fails_at, {"a": [1, 2, 3, 4]}, retries=2, workers=2)
+    assert table.twice.tolist()[:1] == [2] and np.isnan(table.twice[1]) and table.twice.tolist()[2:] == [6, 8]
+    assert table.error.isna().tolist() == [True, False, True, True]
+    assert table.error[1] == "ValueError: no result at a=2"
+    (failure,) = table.attrs["failures"]
+    assert failure["params"] == {"a": 2} and failure["attempts"] == 3
+    assert "raise ValueError(msg)" in failure["traceback"] and "fails_at" in failure["traceback"]
+    assert table.attrs["sweep"]["retries"] == 2 and table.attrs["sweep"]["failed"] == 1
+
+
+def test_retries_rescue_a_flaky_task_and_are_counted(tmp_path):
+    table = ds.sweep(sweep_tasks.flaky, {"a": [1, 2, 3], "marks": str(tmp_path)}, retries=1, workers=2)
+    assert table.error.isna().all() and table.twice.tolist() == [2, 4, 6]
+    assert table.attrs["sweep"]["retries"] == 3 and table.attrs["failures"] == []
+    with pytest.warns(RuntimeWarning):
+        none_left = ds.sweep(sweep_tasks.flaky, {"a": [7], "marks": str(tmp_path)}, retries=0, workers=0)
+    assert none_left.error.tolist() == ["RuntimeError: first attempt at a=7"]
+
+
+def test_failures_are_not_cached_and_run_again(tmp_path):
+    cache = tmp_path / "c"
+    with pytest.warns(RuntimeWarning):
+        ds.sweep(sweep_tasks.flaky, {"a": [1], "marks": str(tmp_path)}, workers=0, cache=cache)
+    table = ds.sweep(sweep_tasks.flaky, {"a": [1], "marks": str(tmp_path)}, workers=0, cache=cache)
+    assert table.twice.tolist() == [2] and table.attrs["sweep"]["ran"] == 1
+
+
+def test_a_worker_that_dies_fails_its_tasks_and_the_pool_is_restarted():
+    with pytest.warns(RuntimeWarning):
+        table = ds.sweep(sweep_tasks.dies, {"a": [0, 1, 2, 3]}, workers=1, retries=1)
+    failed = table[table.error.notna()]
+    assert 1 in failed.a.tolist() and "worker running the task was lost" in failed.error.iloc[0]
+    assert table[table.error.isna()].a2.tolist() == [a * a for a in table[table.error.isna()].a]
+
+
+def test_a_task_that_returns_no_dict_fails_with_a_message():
+    with pytest.warns(RuntimeWarning):
+        table = ds.sweep(sweep_tasks.not_a_dict, {"a": [1]}, workers=0)
+    assert table.error.iloc[0] == "TypeError: the task returned list, not a dict of results (the table's columns)"
+
+
+def test_ctrl_c_stops_the_sweep_and_keeps_what_finished(tmp_path):
+    cache = tmp_path / "c"
+    with pytest.raises(ds.Interrupted, match="2 of 5 tasks unfinished; the 3 finished are in the cache"):
+        ds.sweep(sweep_tasks.interrupts, {"a": [0, 1, 2, 3, 4]}, workers=0, cache=cache)
+    assert len(list(cache.glob("??/*.json"))) == 3
+
+
+# --- bad input: a clear error before any task runs ---------------------------------------------------------
+
+
+def _bad_cases(tmp_path):
+    log = str(tmp_path / "ran.txt")
+    other = tmp_path / "other"
+    ds.sweep(sweep_tasks.draw, {"a": [1.0]}, workers=0, cache=other)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    task = sweep_tasks.logged
+    return [
+        ((task, {}), {}, "the grid is empty"),
+        ((task, []), {}, "the grid is empty"),
+        ((task, {"a": [], "log": log}), {}, r"grid\['a'\] is empty"),
+        ((task, {"a": [1], "log": log, "speed": [2]}), {}, "takes no parameter 'speed'"),
+        ((task, {"log": log}), {}, "needs the parameter 'a'"),
+        ((task, {"a": [1], "log": log, "seed": [3]}), {}, "'seed' is reserved"),
+        ((task, {"a": [1, 1], "log": log}), {}, "repeats point 0"),
+        ((task, {"a": [[1, 2]], "log": log}), {}, "parameter values must be numbers"),
+        ((task, [{"a": 1, "log": log}, {"a": 2}]), {}, "grid point 1 has the parameters"),
+        ((task, "a=1"), {}, "dict of lists or a list of dicts"),
+        ((task, {"a": [1], "log": log}), {"seeds": 0}, "seeds must be at least 1"),
+        ((task, {"a": [1], "log": log}), {"seeds": [1, 1]}, "seeds repeat"),
+        ((task, {"a": [1], "log": log}), {"retries": -1}, "retries must be an integer >= 0"),
+        ((task, {"a": [1], "log": log}), {"workers": -2}, "workers must be an integer >= 0"),
+        ((task, {"a": [1], "log": log}), {"client": object()}, "client must be a dask.distributed.Client"),
+        ((task, {"a": [1], "log": log}), {"cache": other}, "another sweep's task, 'sweep_tasks:draw'"),
+        ((task, {"a": [1], "log": log}), {"cache": foreign}, "holds files but is not a sweep cache"),
+        ((lambda a, seed: {"a": a}, {"a": [1]}), {"workers": 1}, "cannot be sent to worker processes"),
+        ((lambda a, seed: {"a": a}, {"a": [1]}), {"workers": 0, "cache": tmp_path / "l"}, "stable name"),
+        ((42, {"a": [1]}), {}, "task must be a function"),
+    ]
+
+
+def test_bad_input_is_refused_before_any_task_runs(tmp_path):
+    for args, kwargs, match in _bad_cases(tmp_path):
+        with pytest.raises(ds.DiscsimError, match=match):
+            ds.sweep(*args, **kwargs)
+    assert not (tmp_path / "ran.txt").exists() and not (tmp_path / "l").exists()
+    assert [p.name for p in (tmp_path / "foreign").iterdir()] == ["notes.txt"]
+
+
+@pytest.mark.slow
+def test_a_closed_dask_client_is_refused(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        client = distributed.Client(cluster)
+        client.close()
+        with pytest.raises(ds.InvalidArgumentError, match="the dask client is closed"):
+            ds.sweep(sweep_tasks.logged, {"a": [1], "log": str(tmp_path / "ran.txt")}, client=client)
+    assert not (tmp_path / "ran.txt").exists()
+
+
+# --- the command line --------------------------------------------------------------------------------------
+
+SPEC = """
+task = "sweep_tasks:draw"
+seeds = 2
+retries = 1
+[grid]
+a = [1.0, 2.0, 3.0, 4.0]
+pause = {pause}
+"""
+
+
+def _cli(args, start=subprocess.run, **kwargs):
+    """``python -m discsim ARGS`` with the test tasks importable (``start``: run it, or Popen to kill it)."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
+    return start([sys.executable, "-m", "discsim", *map(str, args)], env=env, **kwargs)
+
+
+def test_cli_sweep_writes_the_table_and_reads_ready_made_tasks(tmp_path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(pause=0.0))
+    done = _cli(
+        ["sweep", spec, "--out", tmp_path / "out", "--workers", "2", "--no-progress"], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert "8 tasks (8 ran, 0 from the cache, 0 failed, 0 retries)" in done.stdout
+    table = pd.read_csv(tmp_path / "out" / "sweep.csv")
+    expected = plain_loop(sweep_tasks.draw, {"a": [1.0, 2.0, 3.0, 4.0], "pause": 0.0}, 2)
+    assert table["sum"].tolist() == expected["sum"].tolist() and table.seed.tolist() == expected.seed.tolist()
+    spec.write_text('task = "equation_of_state"\nseeds = [3]\n[[grid]]\npacking_fraction = 0.2\nn = 50\nmeasure = 3\n')
+    done = _cli(["sweep", spec, "--out", tmp_path / "eos", "--workers", "0"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert pd.read_csv(tmp_path / "eos" / "sweep.csv").z.iloc[0] > 1.0
+
+
+def test_cli_sweep_reports_failures_and_bad_specs(tmp_path):
+    spec = tmp_path / "s.toml"
+    spec.write_text('task = "sweep_tasks:fails_at"\n[grid]\na = [1, 2]\n')
+    done = _cli(["sweep", spec, "--out", tmp_path / "out", "--workers", "0"], capture_output=True, text=True)
+    assert done.returncode == 1 and "1 failed" in done.stdout and "no result at a=2" in done.stderr
+    assert "raise ValueError(msg)" in (tmp_path / "out" / "failures.txt").read_text()
+    for text, match in [
+        ('task = "draw_it"\n[grid]\na = 1\n', "not a ready-made task"),
+        ('task = "sweep_tasks:nothing"\n[grid]\na = 1\n', "has no 'nothing'"),
+        ('task = "sweep_tasks:draw"\n[grid]\na = 1\nflavour = 2\nspeed = [1\n', "not valid TOML"),
+        ('task = "sweep_tasks:draw"\ngrid = {a = 1}\nseed = 3\n', r"unknown key\(s\) \['seed'\]"),
+        ('task = "sweep_tasks:draw"\n', "has no 'grid'"),
+    ]:
+        spec.write_text(text)
+        done = _cli(["sweep", spec, "--out", tmp_path / "bad"], capture_output=True, text=True)
+        assert done.returncode == 1 and match.replace("\\", "") in done.stderr.replace("\\", ""), (text, done.stderr)
+    assert not (tmp_path / "bad").exists()
+
+
+@pytest.mark.slow
+def test_cli_sweep_killed_half_way_resumes_running_only_the_missing_tasks(tmp_path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(pause=0.4))
+    out = tmp_path / "out"
+    cache = out / "cache"
+    child = _cli(
+        ["sweep", spec, "--out", out, "--workers", "1", "--no-progress"],
+        start=subprocess.Popen,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 120.0
+    while len(list(cache.glob("??/*.json"))) < 3 and time.monotonic() < deadline and child.poll() is None:
+        time.sleep(0.05)
+    os.killpg(child.pid, signal.SIGKILL)  # the sweep and its pool's worker
+    child.wait()
+    kept = len(list(cache.glob("??/*.json")))
+    assert 3 <= kept < 8, "the kill did not land half-way"
+    assert not (out / "sweep.csv").exists()
+    done = _cli(["sweep", spec, "--out", out, "--workers", "2", "--no-progress"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert f"8 tasks ({8 - kept} ran, {kept} from the cache" in done.stdout
+    whole = _cli(["sweep", spec, "--out", tmp_path / "whole", "--workers", "2", "--no-progress"], capture_output=True)
+    assert whole.returncode == 0
+    assert (out / "sweep.csv").read_text() == (tmp_path / "whole" / "sweep.csv").read_text()
+
+
+@pytest.mark.slow
+def test_cli_sweep_on_a_dask_local_cluster(tmp_path):
+    pytest.importorskip("distributed")
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(pause=0.0))
+    done = _cli(
+        ["sweep", spec, "--out", tmp_path / "d", "--scheduler", "local", "--workers", "2"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "on dask at tcp://" in done.stdout
+    local = _cli(["sweep", spec, "--out", tmp_path / "l", "--workers", "2"], capture_output=True)
+    assert local.returncode == 0
+    assert (tmp_path / "d" / "sweep.csv").read_text() == (tmp_path / "l" / "sweep.csv").read_text()

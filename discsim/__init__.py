@@ -19,7 +19,14 @@ from discsim.analysis.contacts import Contact, Contacts, contacts
 from discsim.analysis.dynamics import free_times, msd, vacf
 from discsim.analysis.frames import Frames, frames
 from discsim.analysis.structure import psi6, rdf
-from discsim.analysis.theory import enskog_collision_rate, enskog_diffusion, henderson_z, speed_cdf, speed_pdf
+from discsim.analysis.theory import (
+    enskog_collision_rate,
+    enskog_diffusion,
+    henderson_z,
+    speed_cdf,
+    speed_pdf,
+    virial_z,
+)
 from discsim.analysis.thermo import compressibility_factor, thermo
 from discsim.engines.compress import CompressionReport, compress
 from discsim.engines.event_driven import EventDriven, EventDrivenState
@@ -45,8 +52,8 @@ from discsim.io.gsd import read_gsd, write_gsd
 from discsim.io.streams import StreamedEvents, read_events, trajectory_from_events
 from discsim.io.xyz import read_xyz, write_xyz
 from discsim.model import Box, Discs, Segment, polygon
-from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 from discsim.run import tasks
+from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 from discsim.run.samplers import GSDWriter, Sampler
 from discsim.run.sweep import sweep
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
@@ -138,6 +145,7 @@ __all__ = [
     "trajectory_from_events",
     "vacf",
     "view",
+    "virial_z",
     "write_gsd",
     "write_xyz",
 ]

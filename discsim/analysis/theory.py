@@ -13,7 +13,16 @@ import numpy as np
 
 from discsim.errors import InvalidArgumentError
 
-__all__ = ["contact_value", "enskog_collision_rate", "enskog_diffusion", "henderson_z", "speed_cdf", "speed_pdf"]
+__all__ = [
+    "DISC_VIRIAL_COEFFICIENTS",
+    "contact_value",
+    "enskog_collision_rate",
+    "enskog_diffusion",
+    "henderson_z",
+    "speed_cdf",
+    "speed_pdf",
+    "virial_z",
+]
 
 
 def _packing(value) -> np.ndarray:
@@ -46,6 +55,47 @@ def henderson_z(packing_fraction):
     """
     eta = _packing(packing_fraction)
     return (1.0 + eta**2 / 8.0) / (1.0 - eta) ** 2
+
+
+#: Reduced virial coefficients ``B_k / B_2^(k-1)`` of hard discs, k = 2..10: B_3 and B_4 exact, B_5..B_10 from
+#: N. Clisby and B. M. McCoy, J. Stat. Phys. 122, 15 (2006), Table 1 (their last digits uncertain).
+DISC_VIRIAL_COEFFICIENTS = (
+    1.0,
+    4.0 / 3.0 - math.sqrt(3.0) / math.pi,  # 0.7820044...
+    2.0 - 9.0 * math.sqrt(3.0) / (2.0 * math.pi) + 10.0 / math.pi**2,  # 0.5322318...
+    0.33355604,
+    0.1988425,
+    0.1148728,
+    0.0649930,
+    0.0362193,
+    0.0199537,
+)
+
+
+def virial_z(packing_fraction, order: int = 10):
+    """The virial series of the hard-disc ``Z``, summed to ``B_order``.
+
+    ``Z = 1 + sum_{k=2}^{order} (B_k / B_2^(k-1)) (2 eta)^(k-1)`` (``B_2 rho = 2 eta`` in 2D), with the
+    coefficients of :data:`DISC_VIRIAL_COEFFICIENTS`. Truncated series lie below the true ``Z`` and part
+    from it as the fluid densifies (at ``eta = 0.6`` the tenth order is 4% below Henderson's equation).
+
+    Args:
+        packing_fraction: ``eta`` (a number or an array), in ``[0, 1)``.
+        order: the last coefficient summed, 2 to 10.
+
+    Example:
+        >>> round(float(virial_z(0.1, order=2)), 6), round(float(virial_z(0.5)), 3)
+        (1.2, 4.083)
+    """
+    eta = _packing(packing_fraction)
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 2 <= order <= 10:
+        msg = f"order must be an integer from 2 to 10 (the last virial coefficient summed), got {order!r}"
+        raise InvalidArgumentError(msg)
+    x = 2.0 * eta
+    z = np.ones_like(x)
+    for k, b in enumerate(DISC_VIRIAL_COEFFICIENTS[: order - 1], start=1):
+        z = z + b * x**k
+    return z
 
 
 def contact_value(packing_fraction):

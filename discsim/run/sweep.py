@@ -599,6 +599,6 @@ def _table(pd, name, jobs, executor, store, resubmitted, seconds, retries):
             f"{first.params}, seed={first.seed}: {first.error}); see the table's 'error' column and "
             f"table.attrs['failures'] for the tracebacks",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=4,  # _table <- _run <- sweep <- the caller
         )
     return table

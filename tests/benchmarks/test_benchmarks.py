@@ -282,4 +282,8 @@ def test_backends_script_writes_both_backends_side_by_side(tmp_path):
         assert float(row["python_rate"]) > 0 and float(row["numba_rate"]) > 0
         assert float(row["speedup"]) == pytest.approx(float(row["numba_rate"]) / float(row["python_rate"]))
     compile_rows = _read_csv(tmp_path / "backends_compile.csv")
-    assert {row["cache"] for row in compile_rows} == {"cold", "warm"}
+    assert {(row["cache"], row["scipy"]) for row in compile_rows} == {
+        ("cold", "visible"),
+        ("warm", "visible"),
+        ("warm", "hidden"),
+    }

@@ -227,11 +227,8 @@ def test_discs_repr_shows_the_radius_range():
         (lambda d, b: ds.henderson_z([0.1, float("nan")]), ds.InvalidArgumentError, "nan"),
         (lambda d, b: ds.enskog_collision_rate(-0.1), ds.InvalidArgumentError, "-0.1"),
         (lambda d, b: ds.henderson_z("dense"), ds.InvalidArgumentError, "'dense'"),
-        (
-            lambda d, b: ds.compressibility_factor(ds.FixedStep(d, b, dt=0.1).run(until=1.0)),
-            ds.InvalidArgumentError,
-            "FixedStep",
-        ),
+        (lambda d, b: ds.compressibility_factor(d), ds.InvalidArgumentError, "Discs"),  # not an engine
+        (lambda d, b: ds.FixedStep(d, b, dt=0.1).pressure(), ds.InvalidArgumentError, "positive duration"),
         (
             lambda d, b: ds.compressibility_factor(
                 ds.EventDriven(ds.Discs(d.positions, np.zeros_like(d.velocities), d.radii), b).run(until=1.0)

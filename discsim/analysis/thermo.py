@@ -43,16 +43,18 @@ def packing_fraction(radii: np.ndarray, area: float) -> float:
 
 
 def compressibility_factor(sim, since: float | None = None) -> float:
-    """``Z = P A / (N kT)`` of an event-driven run (``N kT`` is the kinetic energy).
+    """``Z = P A / (N kT)`` of a run (``N kT`` is the kinetic energy), from the engine's ``pressure()``.
 
     Args:
-        sim: an event-driven engine.
+        sim: an engine: :class:`~discsim.EventDriven` (the exact collision virial) or
+            :class:`~discsim.FixedStep` (the virial of the impulses its frames applied; see
+            ``FixedStep.pressure``).
         since: average from this time on (skip the melting of a starting lattice); None: from the start,
             from the engine's own running virial (no log needed). With ``since``, the run must have kept
             its event log (see :func:`thermo`, which also gives the error bar).
 
     Raises:
-        InvalidArgumentError: if the engine has no ``pressure()`` (``FixedStep`` has none yet) or no
+        InvalidArgumentError: if the object has no ``pressure()`` (it is not an engine) or no
             kinetic energy (no free disc moves), or ``since`` is given and the run recorded nothing.
         TimeError: if ``since`` lies outside the run.
     """
@@ -68,7 +70,7 @@ def compressibility_factor(sim, since: float | None = None) -> float:
 
 def _check_pressure_engine(sim, what: str) -> None:
     if not callable(getattr(sim, "pressure", None)):
-        msg = f"{what} needs an engine with pressure() (an EventDriven run), got {type(sim).__name__}"
+        msg = f"{what} needs an engine with pressure() (EventDriven or FixedStep), got {type(sim).__name__}"
         raise InvalidArgumentError(msg)
 
 
@@ -209,11 +211,13 @@ def thermo(source, since: float | None = None, blocks: int = 10) -> ThermoAverag
     """Pressure, ``Z`` and collision rate of a run from ``since`` on, with error bars from batch means.
 
     The virial of each disc-disc collision comes from the event log (:func:`collision_virials`); over the
-    whole run it equals the engine's own (``sim.pressure()``) to roundoff. The method of the error bars
+    whole run it equals the engine's own (``sim.pressure()``) to roundoff (for a ``FixedStep``, whose log holds
+    the states where its impulses were applied, too; except ``"revert"``'s rare impulses along the frame's
+    line of centres rather than the restored one). The method of the error bars
     (batch means) is described in the module docstring.
 
     Args:
-        source: an event-driven engine that recorded its log (``record=True``) or streamed it
+        source: an engine (event-driven or fixed-step) that recorded its log (``record=True``) or streamed it
             (``run(record_to=...)``, read back chunk by chunk, so memory stays flat), a
             :class:`~discsim.io.streams.StreamedEvents` or the path of a streamed log; or a
             :class:`discsim.Sampler` that observed the run (which needs no log: its blocks are ``dt / 8``
@@ -226,7 +230,7 @@ def thermo(source, since: float | None = None, blocks: int = 10) -> ThermoAverag
 
     Raises:
         InvalidArgumentError: if the run recorded nothing (``record=False`` and no stream), the engine has no
-            pressure (``FixedStep``), the discs are at rest, or ``blocks`` is not an integer >= 2.
+            pressure, the discs are at rest, or ``blocks`` is not an integer >= 2.
         TimeError: if ``since`` is not a time within the run (``start <= since < end``).
 
     Example:

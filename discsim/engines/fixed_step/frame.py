@@ -26,7 +26,7 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally, impulse_virial
 from discsim.engines.fixed_step.broad_phase import BroadPhase
 from discsim.events import Event
 from discsim.kernels import closest_point_on_segment, reflect_off_segment, resolve_collision
@@ -249,6 +249,7 @@ class FramePolicy(Policy):
         before = dict(zip(keys, prev[involved].tolist(), strict=True)) if self.uses_previous else None
         changed = set()
         detections = 0
+        virial = tally.virial
         for i, j in zip(ii, jj, strict=True):
             xi, yi = at[i]
             xj, yj = at[j]
@@ -266,6 +267,11 @@ class FramePolicy(Policy):
             sigma = radius[i] + radius[j]
             xi, yi, xj, yj, dx, dy = self.contact(xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, before_i, before_j)
             uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+            sx, sy = xj - xi, yj - yi  # where the impulse is applied (moved there by "revert" or "separate")
+            if periodic:
+                sx -= width * round(sx / width)
+                sy -= height * round(sy / height)
+            virial += impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj)
             at[i], at[j] = (xi, yi), (xj, yj)
             speed[i], speed[j] = (uxi, uyi), (uxj, uyj)
             changed.add(i)
@@ -280,6 +286,7 @@ class FramePolicy(Policy):
             vel[done] = [speed[k] for k in done]
             paths.restart(done, pos[done], t, flown[done])
         tally.counts["detections"] += detections
+        tally.virial = virial
 
 
 class Resolve(FramePolicy):

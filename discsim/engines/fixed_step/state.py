@@ -6,6 +6,7 @@ in it is Python-specific.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,7 +18,7 @@ __all__ = ["FixedStepState"]
 
 @dataclass(eq=False)
 class FixedStepState(EngineState):
-    """Everything a fixed-step run needs to continue bit for bit (version 1).
+    """Everything a fixed-step run needs to continue bit for bit (version 2).
 
     Per-disc arrays are indexed as ``discs``. Frame ``k`` falls at ``start_time + k / frame_rate`` (or
     ``start_time + k * dt``, as the engine was built), so the frame count fixes the frame times.
@@ -29,6 +30,8 @@ class FixedStepState(EngineState):
         pair_tests, segment_tests, bisection_tests, detections, wall_hits, list_builds:
             the counters (see ``FixedStep.counts``).
         max_overlap: the deepest disc-disc overlap seen, as a fraction of the contact distance.
+        virial: the sum over the disc-disc impulses applied since the start of ``dp_i . (r_i - r_j)``
+            (energy; ``FixedStep.pressure()``); NaN when unknown (a version 1 state: see below).
 
     Arrays:
         ref_positions ``(N, 2)``, velocities ``(N, 2)``, ref_times ``(N,)``:
@@ -40,9 +43,12 @@ class FixedStepState(EngineState):
         list_positions ``(N, 2)``: where the discs were when the Verlet list of the ``"grid"``
             broad phase was last built, or ``(0, 2)`` if it never was (``list_builds == 0``).
         list_i, list_j ``(P,)`` int64: the pairs of discs in that list.
+
+    Versions: 1 had no ``virial``; it is read with ``virial = NaN`` (:meth:`from_arrays`), which
+    ``FixedStep`` rebuilds from the event log when the log covers the whole run.
     """
 
-    VERSION = 1
+    VERSION = 2
 
     time: float
     frame_time: float
@@ -54,6 +60,7 @@ class FixedStepState(EngineState):
     wall_hits: int
     list_builds: int
     max_overlap: float
+    virial: float
     ref_positions: np.ndarray
     velocities: np.ndarray
     ref_times: np.ndarray
@@ -62,6 +69,13 @@ class FixedStepState(EngineState):
     list_positions: np.ndarray
     list_i: np.ndarray
     list_j: np.ndarray
+
+    @classmethod
+    def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int) -> FixedStepState:
+        """As :meth:`EngineState.from_arrays`; a version 1 state (before ``virial``) gets ``virial = NaN``."""
+        if version == 1 and "virial" not in scalars:
+            return super().from_arrays({**scalars, "virial": math.nan}, arrays, cls.VERSION)
+        return super().from_arrays(scalars, arrays, version)
 
     @property
     def counts(self) -> dict[str, int]:

@@ -33,7 +33,7 @@ from abc import abstractmethod
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally, impulse_virial
 from discsim.engines.fixed_step.broad_phase import BroadPhase
 from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
 from discsim.errors import InvalidArgumentError, JammedError
@@ -258,7 +258,9 @@ class SubFrame:
             return
         sigma = shapes.radius[a] + shapes.radius[b]
         self.tally.max_overlap = max(self.tally.max_overlap, 1.0 - math.hypot(dx, dy) / sigma)
-        uxa, uya, uxb, uyb = resolve_collision(dx, dy, vxa, vya, vxb, vyb, shapes.masses[a], shapes.masses[b])
+        ma, mb = shapes.masses[a], shapes.masses[b]
+        uxa, uya, uxb, uyb = resolve_collision(dx, dy, vxa, vya, vxb, vyb, ma, mb)
+        self.tally.virial += impulse_virial(dx, dy, vxa, vya, uxa, uya, vxb, vyb, uxb, uyb, ma, mb)
         moving = shapes.moving
         if moving[a]:
             xa, ya = self._turn(a, tc, xa, ya, uxa, uya)

@@ -186,6 +186,14 @@ def _collide(dx, dy, v1x, v1y, v2x, v2y, m1, m2):
     return v1x + f1 * k * dx, v1y + f1 * k * dy, v2x - f2 * k * dx, v2y - f2 * k * dy
 
 
+@jit
+def _impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj):
+    """:func:`discsim.engines.fixed_step.arrays.impulse_virial`."""
+    if mi != INF:
+        return -mi * ((uxi - vxi) * sx + (uyi - vyi) * sy)
+    return mj * ((uxj - vxj) * sx + (uyj - vyj) * sy)
+
+
 # --- the event buffer ------------------------------------------------------------------------------------
 # A frame's events go to ``ev_n`` (E, 3) int64: the frame's index in the batch, disc i, disc j (-1 for a
 # wall or segment hit); and ``ev_f`` (E, 8): the discs' positions and velocities after (NaN for no j).
@@ -547,8 +555,9 @@ def _contact(policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j
 
 
 @jit
-def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame):
-    """Answer the overlapping pairs in order (keys ``i * N + j``); returns the events written so far.
+def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial):
+    """Answer the overlapping pairs in order (keys ``i * N + j``); returns ``(k, virial)``: the events
+    written so far and the collision virial with these responses added.
 
     Marks the discs that change course in ``changed``; in a periodic box, keeps in ``flown`` where each
     one's old path put it at ``t`` (``Paths.flown``, not wrapped), for its image count.
@@ -572,6 +581,10 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
             policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j, periodic, width, height
         )
         uxi, uyi, uxj, uyj = _collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+        sx, sy = xj - xi, yj - yi  # where the impulse is applied
+        if periodic:
+            sx, sy = _image(sx, width), _image(sy, height)
+        virial += _impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj)
         if periodic:  # no walls: ref_pos, ref_t and vel still hold the path the disc had at the last frame
             for d in (i, j):
                 if not changed[d]:
@@ -584,7 +597,7 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
         f = ev_f[k]
         f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7] = xi, yi, uxi, uyi, xj, yj, uxj, uyj
         k += 1
-    return k
+    return k, virial
 
 
 # --- the frame -------------------------------------------------------------------------------------------
@@ -593,13 +606,13 @@ C_PAIR_TESTS, C_SEGMENT_TESTS, C_DETECTIONS, C_WALL_HITS, C_LIST_BUILDS = range(
 
 
 @jit
-def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap):
+def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap, virial):
     """One frame at time ``t`` (index ``frame`` in the batch): from ``frame_pos`` (the last frame's
     positions) to ``pos`` (written); see :func:`frames`.
 
     Returns:
-        ``(k, ev_n, ev_f, list_pos, list_i, list_j, overlap)``: the events written so far, the buffer, the
-        Verlet list and the deepest overlap.
+        ``(k, ev_n, ev_f, list_pos, list_i, list_j, overlap, virial)``: the events written so far, the
+        buffer, the Verlet list, the deepest overlap and the collision virial.
     """
     ref_pos, vel, ref_t, images = paths
     radii, _, periodic, width, height, segments, group, blocked, filtering = scene
@@ -635,7 +648,7 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
         changed = np.zeros(n, dtype=np.bool_)
         flown = np.empty((n if periodic else 0, 2))
         before = k
-        k = _pairs(policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame)
+        k, virial = _pairs(policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial)
         counts[C_DETECTIONS] += k - before
         for i in range(n):  # Paths.restart
             if not changed[i]:
@@ -648,11 +661,11 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
         if periodic:
             for i in range(n):
                 pos[i, 0], pos[i, 1] = _wrap(pos[i, 0], width), _wrap(pos[i, 1], height)
-    return k, ev_n, ev_f, list_pos, list_i, list_j, overlap
+    return k, ev_n, ev_f, list_pos, list_i, list_j, overlap, virial
 
 
 @jit
-def frames(policy, times, scene, paths, broad, counts, overlap):
+def frames(policy, times, scene, paths, broad, counts, overlap, virial):
     """Frames at ``times`` one after the other: move every disc to the frame, then answer what overlaps there.
 
     Changes the paths in place, as ``FramePolicy.frame`` changes
@@ -671,12 +684,13 @@ def frames(policy, times, scene, paths, broad, counts, overlap):
             the pairs nearer than ``sqrt(reach2)``, found on ``nx x ny`` cells (``per_x``, ``per_y`` cells
             per unit length).
         counts: the counters (int64, changed in place). overlap: the deepest overlap seen so far.
+        virial: the collision virial so far (``Tally.virial``).
 
     Returns:
-        ``(ev_n, ev_f, frame_pos, list_pos, list_i, list_j, overlap)``: the events, in order, as ``ev_n``
-        ``(E, 3)`` (frame index in ``times``, disc i, disc j or -1 for a wall or segment hit) and ``ev_f``
-        ``(E, 8)`` (positions and velocities after, as the log holds them); the positions at the last
-        frame; the Verlet list; the deepest overlap.
+        ``(ev_n, ev_f, frame_pos, list_pos, list_i, list_j, overlap, virial)``: the events, in order, as
+        ``ev_n`` ``(E, 3)`` (frame index in ``times``, disc i, disc j or -1 for a wall or segment hit) and
+        ``ev_f`` ``(E, 8)`` (positions and velocities after, as the log holds them); the positions at the
+        last frame; the Verlet list; the deepest overlap; the collision virial.
     """
     ref_pos, vel, ref_t, images, frame_pos = paths
     moving = (ref_pos, vel, ref_t, images)
@@ -687,8 +701,8 @@ def frames(policy, times, scene, paths, broad, counts, overlap):
     all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
     for f in range(len(times)):
         here = (all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y)
-        k, ev_n, ev_f, list_pos, list_i, list_j, overlap = _frame(
-            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap
+        k, ev_n, ev_f, list_pos, list_i, list_j, overlap, virial = _frame(
+            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap, virial
         )
         prev, pos = pos, prev
-    return ev_n[:k], ev_f[:k], prev, list_pos, list_i, list_j, overlap
+    return ev_n[:k], ev_f[:k], prev, list_pos, list_i, list_j, overlap, virial

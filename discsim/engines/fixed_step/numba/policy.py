@@ -3,7 +3,7 @@
 :class:`CompiledFrame` keeps the scene as plain arrays, calls
 :func:`~discsim.engines.fixed_step.numba.kernels.frames` on the engine's
 :class:`~discsim.engines.fixed_step.arrays.Paths` for one frame or a batch of them, and writes back what
-the Python frame would: the counters and the deepest overlap
+the Python frame would: the counters, the deepest overlap and the collision virial
 (:class:`~discsim.engines.fixed_step.arrays.Tally`), the Verlet list (kept in the broad phase, whose
 :meth:`~discsim.engines.fixed_step.broad_phase.BroadPhase.export` reads it), the event log, and the
 :class:`~discsim.events.Event` list that ``step()`` returns.
@@ -94,10 +94,11 @@ class CompiledFrame(Policy):
         counts = self._counts
         counts[:] = 0
         state = (paths.ref_positions, paths.velocities, paths.ref_times, paths.images, paths.frame_positions)
-        ev_n, ev_f, paths.frame_positions, list_pos, list_i, list_j, overlap = kernels.frames(
-            self._code, times, self._scene, state, listed, counts, tally.max_overlap
+        ev_n, ev_f, paths.frame_positions, list_pos, list_i, list_j, overlap, virial = kernels.frames(
+            self._code, times, self._scene, state, listed, counts, tally.max_overlap, tally.virial
         )
         tally.max_overlap = overlap
+        tally.virial = virial
         steps = counts.tolist()
         for name, step in zip(_COUNTERS, steps):
             tally.counts[name] += step

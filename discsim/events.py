@@ -15,14 +15,17 @@ from typing import NamedTuple
 import numpy as np
 
 __all__ = [
+    "ADD",
     "COLLISION",
     "EVENT_DTYPE",
     "KIND_NAMES",
+    "REMOVE",
     "SET",
     "WALL",
     "Event",
     "EventKind",
     "EventLog",
+    "added_discs",
     "event_from_record",
 ]
 
@@ -31,9 +34,10 @@ class EventKind(IntEnum):
     """The one numbering of event kinds, in the log (``kind`` field) and in the engines' queues.
 
     The log holds ``COLLISION`` (disc-disc), ``WALL`` (a wall or a segment
-    hit) and ``SET`` (a disc changed by the user: ``set_velocities``, ``apply_impulse``,
-    ``set_positions``; ``j`` is -1) only; ``CROSSING`` (a disc enters another cell) and ``SEGMENT`` (a
-    segment hit, logged as ``WALL``) live in the engines' queues.
+    hit), ``SET`` (a disc changed by the user: ``set_velocities``, ``apply_impulse``,
+    ``set_positions``; ``j`` is -1), ``ADD`` and ``REMOVE`` (a disc added by ``add_discs`` or removed by
+    ``remove_discs``; ``j`` is -1; see :class:`EventLog` for their fields) only; ``CROSSING`` (a disc
+    enters another cell) and ``SEGMENT`` (a segment hit, logged as ``WALL``) live in the engines' queues.
     """
 
     COLLISION = 0
@@ -41,12 +45,16 @@ class EventKind(IntEnum):
     CROSSING = 2
     SEGMENT = 3
     SET = 4
+    ADD = 5
+    REMOVE = 6
 
 
 COLLISION = int(EventKind.COLLISION)
 WALL = int(EventKind.WALL)
 SET = int(EventKind.SET)
-KIND_NAMES = {COLLISION: "collision", WALL: "wall", SET: "set"}
+ADD = int(EventKind.ADD)
+REMOVE = int(EventKind.REMOVE)
+KIND_NAMES = {COLLISION: "collision", WALL: "wall", SET: "set", ADD: "add", REMOVE: "remove"}
 
 
 class Event(NamedTuple):
@@ -54,7 +62,8 @@ class Event(NamedTuple):
 
     Attributes:
         time: when it happened.
-        kind: ``"collision"`` (disc-disc), ``"wall"``, or ``"set"`` (a change made by the user).
+        kind: ``"collision"`` (disc-disc), ``"wall"``, or a change made by the user: ``"set"``, ``"add"``,
+            ``"remove"``.
         i: the first disc. j: the second disc, or -1 for a wall hit.
     """
 
@@ -69,9 +78,11 @@ def event_from_record(record) -> Event:
     return Event(float(record["time"]), KIND_NAMES[int(record["kind"])], int(record["i"]), int(record["j"]))
 
 
-#: One event: time, kind (0 disc-disc, 1 wall), discs ``i`` and ``j`` (``j`` is
+#: One event: time, kind (:class:`EventKind`), discs ``i`` and ``j`` (``j`` is
 #: -1 for a wall hit), and each disc's position and velocity after the event
-#: (NaN for the absent ``j``).
+#: (NaN for the absent ``j``). Discs are named by their id (``sim.ids``: a disc's index until some disc
+#: is removed). ``ADD`` and ``REMOVE`` records use the ``j`` fields for what the disc is or was (see
+#: :class:`EventLog`).
 EVENT_DTYPE = np.dtype(
     [
         ("time", "f8"),
@@ -122,6 +133,12 @@ class EventLog:
         (2, [1, -1])
     """
 
+    #: ``(N,)`` int64: the id of each disc the engine's loop names by its index, or None when they are the
+    #: same (until a disc is removed). Records from the loop (:meth:`collision`, :meth:`wall`,
+    #: :meth:`extend`) are renamed through it as they move into the arrays; :meth:`set`, :meth:`add` and
+    #: :meth:`remove` take ids. Change it only after :meth:`flush`.
+    ids: np.ndarray | None = None
+
     def __init__(self):
         self._pending: list[tuple] = []  # rows not yet in the arrays, oldest first
         self._blocks: list[np.ndarray] = []  # full (or joined) arrays of rows, oldest first; never written again
@@ -144,19 +161,75 @@ class EventLog:
             self._flush()
 
     def set(self, t, i, xi, yi, vxi, vyi) -> None:
-        """Record that the user changed disc ``i`` at time ``t``, with its state after the change (rare: one copy)."""
-        self.extend(np.array([(t, SET, i, -1, xi, yi, vxi, vyi, _NAN, _NAN, _NAN, _NAN)], dtype=EVENT_DTYPE))
+        """Record that the user changed disc (id) ``i`` at time ``t``, with its state after the change (rare)."""
+        self.flush()
+        self._put(np.array([(t, SET, i, -1, xi, yi, vxi, vyi, _NAN, _NAN, _NAN, _NAN)], dtype=EVENT_DTYPE))
+
+    def add(self, t, ids, positions, velocities, radii, masses, groups) -> None:
+        """Record that discs ``ids`` ``(K,)`` were added at time ``t``: one ``ADD`` record each.
+
+        ``xi, yi, vxi, vyi`` hold the disc's state; ``xj`` its radius, ``yj`` its mass, and ``vxj`` the 64
+        bits of its integer group label (``np.int64(label).view(np.float64)``, exact for every label;
+        :func:`added_discs` reads them back); ``j`` is -1 and ``vyj`` NaN.
+        """
+        k = len(ids)
+        rows = np.empty(k, dtype=EVENT_DTYPE)
+        rows["time"], rows["kind"], rows["i"], rows["j"] = t, ADD, ids, -1
+        rows["xi"], rows["yi"] = positions[:, 0], positions[:, 1]
+        rows["vxi"], rows["vyi"] = velocities[:, 0], velocities[:, 1]
+        rows["xj"], rows["yj"] = radii, masses
+        rows["vxj"] = np.asarray(groups).astype(np.int64).view(np.float64)
+        rows["vyj"] = _NAN
+        self.flush()
+        self._put(rows)
+
+    def remove(self, t, ids, positions, velocities) -> None:
+        """Record that discs ``ids`` ``(K,)`` were removed at time ``t``: one ``REMOVE`` record each.
+
+        The state after is NaN (``xi, yi, vxi, vyi``: the disc is gone, so a trajectory rebuilt from the log
+        is NaN from then on); ``xj, yj, vxj, vyj`` hold where it was and its velocity then; ``j`` is -1.
+        """
+        k = len(ids)
+        rows = np.empty(k, dtype=EVENT_DTYPE)
+        rows["time"], rows["kind"], rows["i"], rows["j"] = t, REMOVE, ids, -1
+        for name in ("xi", "yi", "vxi", "vyi"):
+            rows[name] = _NAN
+        rows["xj"], rows["yj"] = positions[:, 0], positions[:, 1]
+        rows["vxj"], rows["vyj"] = velocities[:, 0], velocities[:, 1]
+        self.flush()
+        self._put(rows)
 
     def extend(self, records: np.ndarray) -> None:
-        """Append records given as a structured array of :data:`EVENT_DTYPE` (one copy)."""
+        """Append records given as a structured array of :data:`EVENT_DTYPE` (one copy), renamed by :attr:`ids`."""
         self._flush()
+        self._put(self._renamed(records))
+
+    def restore(self, records: np.ndarray) -> None:
+        """Append records already in ids (a log read back from a file), as they are."""
+        self.flush()
         self._put(records)
+
+    def _renamed(self, rows: np.ndarray) -> np.ndarray:
+        """``rows`` with ``i`` and ``j`` turned from the loop's indices into ids (a copy; as is without ids)."""
+        ids = self.ids
+        if ids is None or not len(rows):
+            return rows
+        rows = np.array(rows)
+        rows["i"] = ids[rows["i"]]
+        j = rows["j"]
+        pair = j >= 0
+        rows["j"] = np.where(pair, ids[np.where(pair, j, 0)], j)
+        return rows
+
+    def flush(self) -> None:
+        """Move the pending rows into the arrays (renamed by the :attr:`ids` of now)."""
+        self._flush()
 
     def _flush(self) -> None:
         """Move the pending rows into the arrays."""
         pending = self._pending
         if pending:
-            self._put(np.fromiter(pending, dtype=EVENT_DTYPE, count=len(pending)))
+            self._put(self._renamed(np.fromiter(pending, dtype=EVENT_DTYPE, count=len(pending))))
             pending.clear()
 
     def _put(self, rows: np.ndarray) -> None:
@@ -213,7 +286,7 @@ class EventLog:
         return out
 
     def clear(self) -> None:
-        """Drop every record (arrays handed out by :meth:`to_array` keep theirs)."""
+        """Drop every record (arrays handed out by :meth:`to_array` keep theirs); :attr:`ids` stays."""
         self.__init__()
 
     def __len__(self) -> int:
@@ -253,3 +326,27 @@ class EventLog:
             out = out[:]
         out.flags.writeable = False
         return out
+
+
+def added_discs(events: np.ndarray) -> tuple[np.ndarray, ...]:
+    """What the ``ADD`` records of a log say: ``(ids, times, positions, velocities, radii, masses, groups)``.
+
+    Arrays of ``K`` rows (positions and velocities ``(K, 2)``), one per disc added, in log order.
+
+    Example:
+        >>> log = EventLog()
+        >>> log.add(1.5, [2], np.array([[1.0, 2.0]]), np.array([[0.5, 0.0]]), [0.25], [3.0], [7])
+        >>> ids, times, pos, vel, radii, masses, groups = added_discs(log.to_array())
+        >>> ids.tolist(), pos.tolist(), radii.tolist(), masses.tolist(), groups.tolist()
+        ([2], [[1.0, 2.0]], [0.25], [3.0], [7])
+    """
+    rows = events[events["kind"] == ADD]
+    return (
+        rows["i"].astype(np.int64),
+        rows["time"].astype(np.float64),
+        np.column_stack([rows["xi"], rows["yi"]]).reshape(-1, 2),
+        np.column_stack([rows["vxi"], rows["vyi"]]).reshape(-1, 2),
+        rows["xj"].astype(np.float64),
+        rows["yj"].astype(np.float64),
+        np.ascontiguousarray(rows["vxj"]).view(np.int64).copy(),
+    )

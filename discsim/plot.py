@@ -191,7 +191,7 @@ def plot_trajectories(sim, ax=None, discs=None, *, samples: int = 400):
         raise IndexError(msg)
     ax = _axes(ax)
     times = _sample_times(sim, samples)
-    paths = sim.trajectory(times)
+    paths = sim.trajectory(times)[:, sim.ids]  # the discs there now (NaN before one was added: not drawn)
     colours = _disc_colours(sim.discs.masses)
     for i in chosen.tolist():
         path = _break_wraps(paths[:, i, :], sim.box)

@@ -15,7 +15,7 @@ from discsim.cells import neighbour_pairs
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, RESOLUTION, Box, Discs, Segment, normalize_pass_through
 
-__all__ = ["Scene", "check_fits", "check_scene", "filter_table"]
+__all__ = ["Scene", "check_added", "check_fits", "check_scene", "filter_table"]
 
 
 def filter_table(groups: np.ndarray, pass_through: frozenset) -> tuple[np.ndarray, np.ndarray]:
@@ -38,21 +38,30 @@ def filter_table(groups: np.ndarray, pass_through: frozenset) -> tuple[np.ndarra
 
 
 def check_fits(
-    discs: Discs, box: Box, tolerance: float = OVERLAP_TOLERANCE, segments=(), pass_through=frozenset()
+    discs: Discs,
+    box: Box,
+    tolerance: float = OVERLAP_TOLERANCE,
+    segments=(),
+    pass_through=frozenset(),
+    *,
+    new_from: int = 0,
 ) -> None:
     """Raise if a disc is outside ``box``, cut by a wall or a segment, or overlaps another.
 
     Overlaps deeper than ``tolerance`` times the contact distance are errors;
     touching discs are allowed, and so are overlaps between groups that pass
     through each other (``pass_through``: sorted group pairs). O(N) with a cell grid.
+    With ``new_from`` > 0 only the discs from that index on are checked (against every disc), and the
+    messages call them new: the discs before are an engine's own (a fixed-step run may hold overlaps).
 
     Raises:
         OutsideBoxError: naming the disc, its position and radius (and the segment).
         OverlapError: naming the deepest overlapping pair and the depth.
     """
     pos, rad = discs.positions, discs.radii
-    if len(discs) == 0:
+    if len(discs) <= new_from:
         return
+    new = "new disc" if new_from else "disc"
     size = box.size
     if box.periodic:
         bad = ((pos < 0) | (pos >= size)).any(axis=1)
@@ -61,17 +70,22 @@ def check_fits(
         slack = tolerance * rad[:, None]
         bad = ((pos - rad[:, None] < -slack) | (pos + rad[:, None] > size + slack)).any(axis=1)
         what = "outside the box or cut by a wall"
+    bad[:new_from] = False
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is {what} (box {box.width:g} x {box.height:g})"
+        msg = f"{new} {i} at {pos[i].tolist()} with radius {rad[i]:g} is {what} (box {box.width:g} x {box.height:g})"
         raise OutsideBoxError(msg)
     for k, segment in enumerate(segments):
         cut = segment.distance(pos) < rad * (1.0 - tolerance)
+        cut[:new_from] = False
         if cut.any():
             i = int(np.flatnonzero(cut)[0])
-            msg = f"disc {i} at {pos[i].tolist()} with radius {rad[i]:g} is cut by segment {k} {segment!r}"
+            msg = f"{new} {i} at {pos[i].tolist()} with radius {rad[i]:g} is cut by segment {k} {segment!r}"
             raise OutsideBoxError(msg)
     i, j, d = neighbour_pairs(pos, 2.0 * float(rad.max()), box)
+    if new_from:
+        keep = np.maximum(i, j) >= new_from
+        i, j, d = i[keep], j[keep], d[keep]
     if pass_through:
         group, blocked = filter_table(discs.groups, pass_through)
         keep = ~blocked[group[i], group[j]]
@@ -82,11 +96,36 @@ def check_fits(
     bad = depth > tolerance * contact
     if bad.any():
         k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
+        a, b = min(int(i[k]), int(j[k])), max(int(i[k]), int(j[k]))
+        which = f"{new} {b} at {pos[b].tolist()} would overlap {'new ' if a >= new_from else ''}disc {a}"
         msg = (
-            f"discs {min(int(i[k]), int(j[k]))} and {max(int(i[k]), int(j[k]))} overlap by {depth[k]:.6g} "
+            f"{which if new_from else f'discs {a} and {b} overlap'} by {depth[k]:.6g} "
             f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
         )
         raise OverlapError(msg)
+
+
+def check_added(discs: Discs, box: Box, new_from: int, segments=(), pass_through=frozenset()) -> None:
+    """Refuse the discs from index ``new_from`` on (being added to an engine's) as :class:`Scene` refuses discs.
+
+    Their radii must resolve in the box (``RESOLUTION``), and each must fit: in the box, clear of the walls,
+    the segments, every disc before it and every other new one (:func:`check_fits` with ``new_from``).
+    Messages name each new disc by the index it would get.
+
+    Raises:
+        UnitsError, OutsideBoxError, OverlapError.
+    """
+    radii = discs.radii[new_from:]
+    if len(radii):
+        smallest, longest = float(radii.min()), max(box.width, box.height)
+        if smallest < RESOLUTION * longest:
+            i = new_from + int(np.argmin(radii))
+            msg = (
+                f"new disc {i} has radius {smallest!r}, below {RESOLUTION:g} of the box's longer side {longest!r}: "
+                "positions near the far side would not resolve its contacts (discsim.model.RESOLUTION)"
+            )
+            raise UnitsError(msg)
+    check_fits(discs, box, segments=segments, pass_through=pass_through, new_from=new_from)
 
 
 def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[tuple[Segment, ...], frozenset]:
@@ -162,6 +201,8 @@ class Scene:
         box: the :class:`~discsim.model.Box`.
         segments: fixed :class:`~discsim.model.Segment` walls (walled boxes only).
         pass_through: pairs of group labels whose discs pass through each other.
+        check: False for the scene of discs an engine already holds (``add_discs`` checks the new ones with
+            :func:`check_added`): ``segments`` and ``pass_through`` as a scene holds them, no check at all.
 
     Attributes:
         discs, box: as given. segments (tuple[Segment, ...]): as given.
@@ -183,7 +224,12 @@ class Scene:
         [True]
     """
 
-    def __init__(self, discs: Discs, box: Box, segments=(), pass_through=()):
+    def __init__(self, discs: Discs, box: Box, segments=(), pass_through=(), *, check: bool = True):
+        if not check:  # the discs, segments and filter of an engine's own scene, validated when they came in
+            self.segments, self.pass_through = tuple(segments), frozenset(pass_through)
+            self.discs, self.box = discs, box
+            self.group, self.blocked = filter_table(discs.groups, self.pass_through)
+            return
         if not isinstance(discs, Discs):
             msg = f"discs must be a discsim.Discs, got {type(discs).__name__} {_short(discs)}"
             raise WrongTypeError(msg)

@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from discsim.errors import TimeError
+from discsim.events import added_discs
 
-__all__ = ["check_times", "positions_from_log", "reconstruct"]
+__all__ = ["check_times", "log_start", "positions_from_log", "reconstruct"]
 
 
 def check_times(times, start: float, end: float, span: str) -> np.ndarray:
@@ -68,7 +69,9 @@ def reconstruct(
 
     Returns:
         ``(T, N, 2)`` positions. An event exactly at a requested time counts as
-        having happened (positions are continuous there anyway).
+        having happened (positions are continuous there anyway). A disc whose
+        state is NaN (not yet added at ``time0``, or after its ``REMOVE`` record)
+        is NaN there (see :func:`log_start`).
     """
     times = np.atleast_1d(np.asarray(times, dtype=float))
     n = len(positions0)
@@ -119,7 +122,7 @@ def _image_shifts(disc, t_rec, state, starts, size) -> np.ndarray:
     later logged position differs from the earlier one's flight by whole box lengths plus roundoff.
     """
     flown = state[:-1, :2] + state[:-1, 2:] * (t_rec[1:] - t_rec[:-1])[:, None]
-    jump = np.round((flown - state[1:, :2]) / size) * size
+    jump = np.nan_to_num(np.round((flown - state[1:, :2]) / size) * size)  # NaN: not there yet, or gone
     jump[np.isin(np.arange(1, len(state)), starts)] = 0.0  # the first record of the next disc
     shifts = np.zeros_like(state[:, :2])
     shifts[1:] = np.cumsum(jump, axis=0)
@@ -127,10 +130,40 @@ def _image_shifts(disc, t_rec, state, starts, size) -> np.ndarray:
     return shifts - first
 
 
-def positions_from_log(events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool):
-    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` at ``start_time``.
+def log_start(events, discs, ids=None) -> tuple[np.ndarray, ...]:
+    """Every disc a log names, by id: ``(positions, velocities, radii, masses, groups)`` of ``M`` rows.
 
-    Checks ``times`` first (:func:`check_times`, naming the ``span``). Returns positions ``(T, N, 2)``.
+    A log names its discs by id (:attr:`discsim.engines.base.Engine.ids`); ``M`` is one more than the
+    largest id in ``ids`` or in the log's ``ADD`` records. Row ``k`` is disc id ``k``: its state at the
+    log's start (``discs``, whose ids are ``ids``; default ``0 .. len(discs) - 1``) or NaN if it was not
+    there then (added later: its ``ADD`` record gives its state, radius, mass and group; or removed before
+    the log starts: NaN radius and mass). Without ``ADD`` records and ids these are the arrays of ``discs``.
+
+    Returns:
+        positions, velocities ``(M, 2)``; radii, masses ``(M,)`` float; groups ``(M,)`` int64.
+    """
+    added, _, _, _, radii_added, masses_added, groups_added = added_discs(events) if len(events) else ((),) * 7
+    if ids is None and not len(added):
+        return discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups
+    ids = np.arange(len(discs)) if ids is None else np.asarray(ids, dtype=np.int64)
+    m = max(int(ids.max()) + 1 if len(ids) else 0, int(np.max(added)) + 1 if len(added) else 0)
+    positions, velocities = np.full((m, 2), np.nan), np.full((m, 2), np.nan)
+    radii, masses, groups = np.full(m, np.nan), np.full(m, np.nan), np.zeros(m, dtype=np.int64)
+    positions[ids], velocities[ids] = discs.positions, discs.velocities
+    radii[ids], masses[ids], groups[ids] = discs.radii, discs.masses, discs.groups
+    if len(added):
+        radii[added], masses[added], groups[added] = radii_added, masses_added, groups_added
+    return positions, velocities, radii, masses, groups
+
+
+def positions_from_log(
+    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None
+):
+    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``.
+
+    Checks ``times`` first (:func:`check_times`, naming the ``span``). Returns positions ``(T, M, 2)``: one
+    column per disc id (:func:`log_start`), NaN where that disc was not in the simulation.
     """
     times = check_times(times, start_time, end_time, span)
-    return reconstruct(events, discs.positions, discs.velocities, start_time, times, box, unwrapped=unwrapped)
+    positions, velocities = log_start(events, discs, ids)[:2]
+    return reconstruct(events, positions, velocities, start_time, times, box, unwrapped=unwrapped)

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION, EVENT_DTYPE
+from discsim.events import ADD, COLLISION, EVENT_DTYPE, REMOVE
 
 __all__ = ["COLOUR_MODES", "DEFAULT_MAX_EVENTS", "View", "view"]
 
@@ -65,6 +65,16 @@ class _Run:
     end_time: float
     events: np.ndarray
     dt: float | None
+
+    def __post_init__(self):
+        changed = np.flatnonzero((self.events["kind"] == ADD) | (self.events["kind"] == REMOVE))
+        if len(changed):
+            t = float(self.events["time"][changed[0]])
+            msg = (
+                f"cannot view {self.label!r}: the viewer replays a fixed set of discs, and this run added or removed "
+                f"discs (add_discs / remove_discs) at time {t!r}; view a run without such changes"
+            )
+            raise InvalidArgumentError(msg)
 
 
 # --- reading the sources ---------------------------------------------------------------------------------

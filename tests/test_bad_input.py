@@ -225,11 +225,81 @@ CASES = [
     ("newtons_cradle string", lambda w: ds.newtons_cradle("five"), "'five'"),
     ("henderson_z above 1", lambda w: ds.henderson_z(1.2), "1.2"),
     ("enskog_collision_rate negative", lambda w: ds.enskog_collision_rate(-0.1), "-0.1"),
+    # --- add_discs, remove_discs (issue 19), on both engines: the new disc named by the index it would get ---
+    *[
+        case
+        for engine in ("sim", "pit")
+        for case in (
+            (f"{engine} add_discs a list", lambda w, e=engine: w[e].add_discs([[1.0, 1.0]]), "list"),
+            (
+                f"{engine} add_discs on a disc",
+                lambda w, e=engine: w[e].add_discs(ds.Discs([w[e].positions[3]], [[0.0, 0.0]], 0.2)),
+                "new disc 20 at",
+            ),
+            (
+                f"{engine} add_discs overlapping each other",
+                lambda w, e=engine: w[e].add_discs(_free_pair(w[e], 0.05)),
+                "new disc 21",
+            ),
+            (
+                f"{engine} add_discs outside the box",
+                lambda w, e=engine: w[e].add_discs(ds.Discs([[-1.0, 2.0]], [[0.0, 0.0]], 0.1)),
+                "[-1.0, 2.0]",
+            ),
+            (
+                f"{engine} add_discs too fast",
+                lambda w, e=engine: w[e].add_discs(ds.Discs([_free_spot(w[e], 0.1)], [[1e60, 0.0]], 0.1)),
+                "1e+60",
+            ),
+            (
+                f"{engine} add_discs below the resolution",
+                lambda w, e=engine: w[e].add_discs(ds.Discs([_free_spot(w[e], 0.1)], [[0.0, 0.0]], 1e-12)),
+                "new disc 20 has radius 1e-12",
+            ),
+            (f"{engine} remove_discs out of range", lambda w, e=engine: w[e].remove_discs([3, 20]), "20"),
+            (f"{engine} remove_discs negative", lambda w, e=engine: w[e].remove_discs(-1), "-1"),
+            (f"{engine} remove_discs twice", lambda w, e=engine: w[e].remove_discs([4, 4]), "4 is given twice"),
+            (f"{engine} remove_discs a float", lambda w, e=engine: w[e].remove_discs([1.5]), "[1.5]"),
+            (f"{engine} remove_discs booleans", lambda w, e=engine: w[e].remove_discs([True]), "[True]"),
+            (f"{engine} remove_discs a string", lambda w, e=engine: w[e].remove_discs("all"), "'all'"),
+        )
+    ],
+    (
+        "add_discs cut by a wall",
+        lambda w: ds.EventDriven(ds.Discs([[5.0, 5.0]], [[0.0, 0.0]], 0.2), ds.Box(10, 10)).add_discs(
+            ds.Discs([[0.05, 5.0]], [[0.0, 0.0]], 0.1)
+        ),
+        "new disc 1 at [0.05, 5.0] with radius 0.1 is outside the box or cut by a wall",
+    ),
+    (
+        "add_discs cut by a segment",
+        lambda w: ds.EventDriven(
+            ds.Discs([[1.0, 1.0]], [[0.0, 0.0]], 0.2), ds.Box(10, 10), segments=[ds.Segment([5, 0], [5, 10])]
+        ).add_discs(ds.Discs([[5.05, 5.0]], [[0.0, 0.0]], 0.2)),
+        "new disc 1 at [5.05, 5.0] with radius 0.2 is cut by segment 0",
+    ),
     # --- files ---------------------------------------------------------------------------------------------
     ("load a text file", lambda w: ds.load(_text_file(w)), "notes.txt"),
     ("read_events of a text file", lambda w: ds.read_events(_text_file(w)), "notes.txt"),
     ("resume a text file", lambda w: ds.resume(_text_file(w)), "notes.txt"),
 ]
+
+
+def _free_spot(sim, r):
+    """A place for a disc of radius ``r`` clear of every disc of ``sim`` (the first on a fine grid)."""
+    box = sim.box
+    for x in np.arange(r + 0.01, box.width - r, 0.05):
+        for y in np.arange(r + 0.01, box.height - r, 0.05):
+            d = box.minimum_image(sim.positions - [x, y])
+            if (np.hypot(d[:, 0], d[:, 1]) > sim.discs.radii + 3 * r).all():
+                return [x, y]
+    raise AssertionError("no room")
+
+
+def _free_pair(sim, r):
+    """Two new discs of radius ``r`` that overlap each other, clear of every disc of ``sim``."""
+    x, y = _free_spot(sim, r)
+    return ds.Discs([[x, y], [x + r, y]], [[0.0, 0.0], [0.0, 0.0]], r)
 
 
 def _text_file(w):

@@ -380,6 +380,13 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
         if not getattr(engine, "record", True):
             msg = f"compare() needs the event log of {name}; build the engine with record=True"
             raise InvalidArgumentError(msg)
+    for run in (truth, approx):
+        if getattr(run, "_origin", None) is not None:
+            msg = (
+                f"compare() follows the same discs in both runs, and this {type(run).__name__} added or removed "
+                "discs (add_discs / remove_discs); compare runs started from the same discs instead"
+            )
+            raise InvalidArgumentError(msg)
     n = len(truth.discs)
     if len(approx.discs) != n:
         msg = f"the runs have different numbers of discs: truth {n}, approx {len(approx.discs)}"

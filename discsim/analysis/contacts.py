@@ -20,6 +20,7 @@ import numpy as np
 
 from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION, WALL
+from discsim.trajectory import log_start
 
 __all__ = ["Contact", "Contacts", "contacts", "contacts_of"]
 
@@ -96,6 +97,8 @@ class Contacts:
 def contacts(source, discs=None, box=None, segments=()) -> Contacts:
     """The contacts of a run: from an engine (its log in memory), or from a log with its ``discs`` and ``box``.
 
+    Discs are named as in the log, by id (``sim.ids``; the index unless discs were removed).
+
     Args:
         source: an engine built with ``record=True``, or a structured array of
             :data:`~discsim.events.EVENT_DTYPE` (the log from the start of ``discs``).
@@ -111,14 +114,17 @@ def contacts(source, discs=None, box=None, segments=()) -> Contacts:
         >>> float(c.impulse[0]), float(c.speed[0])
         (2.0, 2.0)
     """
+    ids = None
     if hasattr(source, "events") and hasattr(source, "discs"):
-        discs, box, segments, events = source.discs, source.box, source.segments, source.events
+        box, segments, events = source.box, source.segments, source.events
+        discs, ids = source._log_origin() if hasattr(source, "_log_origin") else (source.discs, None)
     else:
         events = np.asarray(source)
         if discs is None or box is None:
             msg = "contacts(events, discs, box): give the discs where the log starts and the box"
             raise InvalidArgumentError(msg)
-    return contacts_of(events, discs.velocities, discs.masses, discs.radii, box, segments)
+    _, velocities, radii, masses, _ = log_start(events, discs, ids)  # by disc id (add_discs, remove_discs)
+    return contacts_of(events, velocities, masses, radii, box, segments)
 
 
 def contacts_of(events, velocities, masses, radii, box, segments=()) -> Contacts:

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
+from discsim.events import ADD, REMOVE
 from discsim.model import Box, Discs
 from discsim.trajectory import check_times, reconstruct
 
@@ -140,9 +141,38 @@ def log_source(source, what: str):
     (read back chunk by chunk), a :class:`~discsim.io.streams.StreamedEvents`, or the path of a streamed log.
     ``events chunks`` is a function returning an iterator of structured arrays in time order.
 
+    The analyses built on it follow a fixed set of discs: a run that added or removed discs
+    (``add_discs``, ``remove_discs``) is refused, when the engine says so or when a chunk holds an ``ADD``
+    or ``REMOVE`` record (``sim.trajectory`` and :func:`discsim.contacts` do follow such runs).
+
     Raises:
-        InvalidArgumentError: if the run recorded nothing (``record=False`` and no stream), naming ``what``.
+        InvalidArgumentError: if the run recorded nothing (``record=False`` and no stream), or changed its
+            set of discs, naming ``what``.
     """
+    chunks, discs, box, start, end, sim = _log_source(source, what)
+    if sim is not None and sim._origin is not None:
+        raise InvalidArgumentError(_changed_message(what, None))
+
+    def fixed():
+        for records in chunks():
+            changed = np.flatnonzero((records["kind"] == ADD) | (records["kind"] == REMOVE))
+            if len(changed):
+                raise InvalidArgumentError(_changed_message(what, float(records["time"][changed[0]])))
+            yield records
+
+    return fixed, discs, box, start, end, sim
+
+
+def _changed_message(what: str, time: float | None) -> str:
+    when = "" if time is None else f" at time {time!r}"
+    return (
+        f"{what} follows a fixed set of discs, and this run added or removed discs{when} (add_discs / "
+        "remove_discs); use sim.trajectory(times) (NaN where a disc was not there) or analyse the spans "
+        "between changes with fresh engines (sim.snapshot())"
+    )
+
+
+def _log_source(source, what: str):
     from discsim.io.container import iter_stream
     from discsim.io.streams import StreamedEvents, read_events
 

@@ -12,7 +12,9 @@ implements three small protocols, all here as abstract methods:
 - the **checkpoint's** (:mod:`discsim.io.checkpoints`): ``state()`` exports the public run state (an
   :class:`EngineState`: numpy arrays and scalars, versioned), ``_settings()`` the constructor's options as
   JSON, and ``_restore(scene, settings, state, events, start_time)`` rebuilds the engine;
-- the **user's**: ``step()``, ``positions``, ``velocities``, ``unwrapped_positions``, ``counts``.
+- the **user's**: ``step()``, ``positions``, ``velocities``, ``unwrapped_positions``, ``counts``, and the
+  changes ``_set_discs(indices, positions, velocities)`` and ``_restructure(keep, added, scene)`` behind
+  ``set_velocities``, ``apply_impulse``, ``set_positions``, ``add_discs`` and ``remove_discs``.
 
 Everything else (``run``, ``save``, ``events``, exact ``trajectory``, energies, momentum, ``snapshot``) is
 written here once, so ``compare``, ``plot``, notebooks and benchmarks work with any engine and backend.
@@ -35,10 +37,11 @@ from discsim.errors import (
     OutsideBoxError,
     OverlapError,
     UnitsError,
+    WrongTypeError,
 )
 from discsim.events import EVENT_DTYPE, EventLog
 from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, kinetic_energy, momentum
-from discsim.scene import Scene
+from discsim.scene import Scene, check_added
 from discsim.trajectory import positions_from_log
 
 __all__ = ["Engine", "EngineState"]
@@ -114,6 +117,12 @@ class Engine(ABC):
         self._stream: dict | None = None  # this run's log on disk: path, run_id, base, records, end
         self._edits = 0  # discs changed by the user (one SET record each in a recorded log)
         self._handlers: dict[str, list] = {}  # sim.on(kind, fn): callbacks after each event of that kind
+        # Disc ids (add_discs, remove_discs): the log names discs by id; None while ids are the indices.
+        self._ids: np.ndarray | None = None  # (N,) each disc's id
+        self._next_id = len(scene)  # the id the next disc added gets
+        self._origin: tuple[Discs, np.ndarray | None] | None = None  # (discs, ids) where the log starts, once
+        # the discs changed (``discs`` is then the current scene); None: (``discs``, their indices)
+        self._structure = 0  # add_discs / remove_discs calls so far (observers notice the disc set changed)
 
     # --- the driver's protocol ---------------------------------------------------------
     @abstractmethod
@@ -193,6 +202,11 @@ class Engine(ABC):
         """Restart the paths of moving discs ``indices`` ``(K,)`` at ``time`` with ``velocities`` ``(K, 2)`` from
         ``positions`` ``(K, 2)`` (in the box), or from where they are (None). Checked by the caller."""
 
+    @abstractmethod
+    def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None:
+        """Go on at ``time`` with discs ``keep`` ``(N',)`` (increasing indices) and then ``added``, the discs of
+        ``scene`` (checked by the caller). Raises before changing anything if the engine cannot hold them."""
+
     # --- changing the simulation ----------------------------------------------------------
     #: Event kinds a callback can follow with :meth:`on`.
     CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment")
@@ -250,6 +264,143 @@ class Engine(ABC):
         idx = self._disc_indices(indices)
         self._change(idx, self._rows("positions", positions, idx), None)
         return self
+
+    def add_discs(self, discs: Discs) -> np.ndarray:
+        """Add ``discs`` (a :class:`~discsim.model.Discs` of ``K`` discs: positions in the box, velocities, radii,
+        masses, groups) at ``time``. Returns their indices ``N, ..., N + K - 1`` ``(K,)`` int64.
+
+        Validated as the constructor validates the discs: each new disc must lie in the box (in ``[0, width)
+        x [0, height)`` when periodic), clear of the walls, the segments, every disc already there and every
+        other new one (pairs whose groups pass through each other excepted); NaN, non-positive radii or
+        negative masses are refused by ``Discs`` itself. Each new disc gets the next disc id (:attr:`ids`)
+        and an ``ADD`` record in the log (:meth:`~discsim.events.EventLog.add`), so :meth:`trajectory` and
+        the log's readers know where it came from.
+
+        The run goes on from a fresh start at ``time``: every disc is re-predicted (O(N), the cost of
+        building the engine), so ``EventDriven`` then gives, event for event and bit for bit, what a new
+        ``EventDriven(sim.snapshot(), box)`` would give from the same discs (its times shifted by ``time``).
+        Add many discs in one call rather than one by one.
+
+        Raises:
+            WrongTypeError: ``discs`` is not a ``Discs``.
+            OutsideBoxError, OverlapError: naming the new disc by the index it would get (and the disc it
+                would overlap). UnitsError: a radius or speed outside what discsim resolves.
+            BoxTooSmallError, InvalidArgumentError: the larger discs no longer fit the engine's cell grid
+                (a periodic box needs 3 cells of the largest diameter a side; ``cell_size`` below it).
+            Nothing changes then.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], 1.0), ds.Box(10, 10)).run(until=1.0)
+            >>> sim.add_discs(ds.Discs([[8.0, 5.0]], [[-1.0, 0.0]], 1.0)).tolist()
+            [1]
+            >>> sim.run(until=3.0).counts["collisions"], sim.velocities.tolist()
+            (1, [[-1.0, 0.0], [1.0, 0.0]])
+        """
+        self._check_usable()
+        if not isinstance(discs, Discs):
+            msg = f"add_discs needs a discsim.Discs, got {type(discs).__name__} {str(discs)[:60]}"
+            raise WrongTypeError(msg)
+        n, k = len(self.discs), len(discs)
+        if k == 0:
+            return np.zeros(0, dtype=np.int64)
+        speed = np.hypot(discs.velocities[:, 0], discs.velocities[:, 1])
+        lo, hi = SPEED_RANGE
+        bad = (speed > hi) | ((speed < lo) & (speed != 0.0))
+        if bad.any():
+            b = int(np.flatnonzero(bad)[0])
+            msg = (
+                f"new disc {n + b} would have speed {float(speed[b])!r}, outside the range discsim supports "
+                f"([{lo:g}, {hi:g}] or 0; discsim.model.SPEED_RANGE)"
+            )
+            raise UnitsError(msg)
+        now = self.snapshot()
+        everyone = Discs(
+            np.concatenate([now.positions, discs.positions]),
+            np.concatenate([now.velocities, discs.velocities]),
+            np.concatenate([now.radii, discs.radii]),
+            np.concatenate([now.masses, discs.masses]),
+            np.concatenate([now.groups, discs.groups]),
+        )
+        scene = self.scene
+        check_added(everyone, self.box, n, scene.segments, scene.pass_through)
+        new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, check=False)
+        ids = np.arange(self._next_id, self._next_id + k, dtype=np.int64)
+        ids_after, origin = np.concatenate([self.ids, ids]), self._log_origin()
+        self._restructure(np.arange(n), discs, new_scene)
+        self._new_discs(new_scene, ids_after, self._next_id + k, origin)
+        if self._logging or self._stream is not None:
+            self._log.add(self.time, ids, discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups)
+        self._edits += k
+        return np.arange(n, n + k, dtype=np.int64)
+
+    def remove_discs(self, indices):
+        """Remove discs ``indices`` (a list of distinct indices, or one) at ``time``. Returns ``self``.
+
+        The discs after them move down to fill the gaps, as ``np.delete`` does: with ``N`` discs,
+        removing disc ``i`` makes disc ``k > i`` disc ``k - 1``. Indices always number the discs there
+        now (``positions``, ``velocities``, ``discs``, ``step()``'s events, callbacks' contacts), while the
+        log names every disc by its id, which never changes (:attr:`ids` gives the id of each disc now).
+        Each removed disc gets a ``REMOVE`` record (:meth:`~discsim.events.EventLog.remove`); its column of
+        :meth:`trajectory` is NaN from then on. The run goes on from a fresh start at ``time``, as after
+        :meth:`add_discs`.
+
+        Raises:
+            InvalidArgumentError: an index that is not a disc, a repeated index, or one that is not an
+                integer. Nothing changes then.
+
+        Example:
+            >>> import discsim as ds
+            >>> discs = ds.Discs([[2.0, 5.0], [5.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [0.0, 0.0], [-1.0, 0.0]], 0.5)
+            >>> sim = ds.EventDriven(discs, ds.Box(10, 10)).remove_discs([1])
+            >>> sim.ids.tolist(), sim.run(until=2.9).counts["collisions"], sim.velocities.tolist()
+            ([0, 2], 1, [[-1.0, 0.0], [1.0, 0.0]])
+        """
+        idx = self._disc_indices(indices)
+        self._check_usable()
+        if not len(idx):
+            return self
+        n = len(self.discs)
+        keep = np.delete(np.arange(n), idx)
+        now = self.snapshot()
+        gone_positions, gone_velocities = now.positions[np.sort(idx)], now.velocities[np.sort(idx)]
+        rest = Discs(now.positions[keep], now.velocities[keep], now.radii[keep], now.masses[keep], now.groups[keep])
+        scene = self.scene
+        new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
+        gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()
+        self._restructure(keep, None, new_scene)
+        self._new_discs(new_scene, ids_after, self._next_id, origin)
+        if self._logging or self._stream is not None:
+            self._log.remove(self.time, gone, gone_positions, gone_velocities)
+        self._edits += len(idx)
+        return self
+
+    def _new_discs(self, scene: Scene, ids: np.ndarray, next_id: int, origin: tuple) -> None:
+        """After :meth:`_restructure`: the new scene and ids (the log's rows so far renamed by the old ones), and
+        ``origin``, the discs where the log starts (:meth:`_log_origin` before the change)."""
+        self._origin = origin
+        self._log.flush()
+        self.scene, self.discs = scene, scene.discs
+        identity = bool(np.array_equal(ids, np.arange(len(ids))))
+        self._ids = None if identity else _readonly_ids(ids)
+        self._next_id = int(next_id)
+        self._log.ids = self._ids
+        self._structure += 1
+
+    @property
+    def ids(self) -> np.ndarray:
+        """``(N,)`` int64, read-only: the id of each disc, the name the event log and :meth:`trajectory` give it.
+
+        A disc's id is its index until some disc is removed (:meth:`remove_discs`): indices then shift down
+        while ids never change; a disc added later gets the next id never used.
+        """
+        if self._ids is None:
+            return _readonly_ids(np.arange(len(self.discs), dtype=np.int64))
+        return self._ids
+
+    def _log_origin(self) -> tuple[Discs, np.ndarray | None]:
+        """``(discs, ids)`` where the log starts, at ``start_time`` (ids None: their indices)."""
+        return (self.discs, None) if self._origin is None else self._origin
 
     def on(self, kind: str, fn):
         """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"`` or ``"segment"``).
@@ -342,8 +493,8 @@ class Engine(ABC):
             self._set_discs(idx, positions, velocities)
         self._edits += len(idx)
         if (self._logging or self._stream is not None) and len(idx):  # a streamed log takes it at the next run
-            t, pos, vel = self.time, self.positions[idx], self.velocities[idx]
-            for k, i in enumerate(idx.tolist()):
+            t, pos, vel, ids = self.time, self.positions[idx], self.velocities[idx], self.ids[idx]
+            for k, i in enumerate(ids.tolist()):
                 self._log.set(t, i, pos[k, 0], pos[k, 1], vel[k, 0], vel[k, 1])
 
     def _check_places(self, idx: np.ndarray, positions: np.ndarray) -> None:
@@ -478,6 +629,13 @@ class Engine(ABC):
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log.
 
+        Column ``k`` is the disc of id ``k`` (:attr:`ids`): the disc of index ``k`` unless discs were
+        removed. After :meth:`add_discs` or :meth:`remove_discs` there is one column per disc the run ever
+        held (``M >= N``: ``trajectory(t)[:, sim.ids]`` are the discs there now), NaN at times the disc was
+        not there (before its ``ADD`` record, from its ``REMOVE`` record on). After such a change the engine
+        restarts every disc's path from where it is, so positions rebuilt between that change and a
+        disc's next event may differ from the engine's own in the last bits.
+
         Args:
             times: simulated times within ``[start_time, time]``, any order.
             unwrapped: in a periodic box, follow each disc across the edges
@@ -494,15 +652,17 @@ class Engine(ABC):
         if not self.record:
             msg = "trajectory() needs the event log; build the engine with record=True"
             raise InvalidArgumentError(msg)
+        discs, ids = self._log_origin()
         return positions_from_log(
             self._log.to_array(),
-            self.discs,
+            discs,
             self.box,
             self.start_time,
             self.time,
             times,
             span="simulated span",
             unwrapped=unwrapped,
+            ids=ids,
         )
 
     def _refuse_if_streamed(self, what: str) -> None:
@@ -517,3 +677,9 @@ class Engine(ABC):
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n={len(self.discs)}, time={self.time:g}, box={self.box})"
+
+
+def _readonly_ids(ids: np.ndarray) -> np.ndarray:
+    out = np.array(ids, dtype=np.int64)
+    out.flags.writeable = False
+    return out

@@ -4,7 +4,9 @@ A checkpoint is a state file (:mod:`discsim.io.container`: one JSON document plu
 SHA-256 checksum, written atomically) made by ``sim.save(path)`` or by ``run(checkpoint=path, ...)``. It
 holds the scene (initial discs, box, segments, collision filter), the engine's settings, its public run
 state (``sim.state()``: an :class:`~discsim.engines.base.EngineState` of arrays and scalars), and the event
-log or where it was streamed. No pickle: loading a file never runs code from it.
+log or where it was streamed. No pickle: loading a file never runs code from it. After ``add_discs`` or
+``remove_discs`` the ``discs.*`` arrays are the engine's discs now (as at the last change), ``origin.*``
+(and ``origin.ids``) the discs where the log starts, ``ids`` each disc's id and ``next_id`` the next one.
 
 Layouts: ``layout`` 2 (this one) stores the state's fields by name under ``state.``; files written before
 it (an event-driven engine's private arrays, in its internal numbering) are read and converted, and
@@ -82,16 +84,29 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
     }
     out = {f"state.{name}": value for name, value in arrays.items()}
     out["events"] = engine._log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
-    out.update(
-        {
-            "discs.positions": discs.positions,
-            "discs.velocities": discs.velocities,
-            "discs.radii": discs.radii,
-            "discs.masses": discs.masses,
-            "discs.groups": discs.groups,
-        }
-    )
+    out.update(_discs_arrays("discs", discs))
+    if engine._origin is not None:  # the discs changed (add_discs, remove_discs): discs.* are today's scene
+        origin, origin_ids = engine._origin
+        out.update(_discs_arrays("origin", origin))
+        if origin_ids is not None:
+            out["origin.ids"] = np.asarray(origin_ids, dtype=np.int64)
+        out["ids"] = np.asarray(engine.ids, dtype=np.int64)
+        meta["next_id"] = engine._next_id
     return write_state(Path(path), meta, out)
+
+
+def _discs_arrays(prefix: str, discs: Discs) -> dict[str, np.ndarray]:
+    return {
+        f"{prefix}.positions": discs.positions,
+        f"{prefix}.velocities": discs.velocities,
+        f"{prefix}.radii": discs.radii,
+        f"{prefix}.masses": discs.masses,
+        f"{prefix}.groups": discs.groups,
+    }
+
+
+def _discs_from(arrays: dict, prefix: str) -> Discs:
+    return Discs(*(arrays[f"{prefix}.{name}"] for name in ("positions", "velocities", "radii", "masses", "groups")))
 
 
 def checkpoint_info(path) -> dict:
@@ -183,13 +198,8 @@ def load(path, *, backend: str | None = None):
     meta, arrays = read_state(path)
     engine = _engine_class(meta, path)
     try:
-        discs = Discs(
-            arrays["discs.positions"],
-            arrays["discs.velocities"],
-            arrays["discs.radii"],
-            arrays["discs.masses"],
-            arrays["discs.groups"],
-        )
+        discs = _discs_from(arrays, "discs")
+        changed = "ids" in arrays  # the discs changed: discs.* are the engine's own (a fixed-step run may overlap)
         box = Box(**meta["box"])
         if meta.get("layout") == LAYOUT:
             scene_meta, settings = meta["scene"], meta["settings"]
@@ -204,8 +214,20 @@ def load(path, *, backend: str | None = None):
         if backend is not None or (settings.get("backend") == "numba" and not numba_available()):
             settings = {**settings, "backend": backend or "auto"}
         segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
-        scene = Scene(discs, box, segments, [tuple(pair) for pair in scene_meta.get("pass_through", [])])
+        pass_through = [tuple(pair) for pair in scene_meta.get("pass_through", [])]
+        if changed:
+            scene = Scene(discs, box, tuple(segments), frozenset(pass_through), check=False)
+        else:
+            scene = Scene(discs, box, segments, pass_through)
         sim = engine._restore(scene, settings, state, events, float(meta["start_time"]))
+        if changed:
+            ids = np.asarray(arrays["ids"], dtype=np.int64)
+            if ids.shape != (len(discs),):
+                msg = f"ids of shape {ids.shape} for {len(discs)} discs"
+                raise ValueError(msg)
+            origin_ids = arrays.get("origin.ids")
+            sim._new_discs(scene, ids, int(meta["next_id"]), (_discs_from(arrays, "origin"), origin_ids))
+            sim._structure = 0
     except (KeyError, TypeError, IndexError, ValueError, DiscsimError) as exc:
         msg = f"{path}: the checkpoint is incomplete or inconsistent ({type(exc).__name__}: {exc})"
         raise CheckpointError(msg) from exc

@@ -23,7 +23,9 @@ __all__ = ["STREAM_KIND", "StreamedEvents", "read_events", "stream_header", "tra
 STREAM_KIND = "discsim event log"
 
 
-def stream_header(discs: Discs, box: Box, start_time: float, run_id: str, base: int) -> tuple[dict, dict]:
+def stream_header(
+    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None
+) -> tuple[dict, dict]:
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
     Args:
@@ -31,6 +33,7 @@ def stream_header(discs: Discs, box: Box, start_time: float, run_id: str, base: 
         box: the box. start_time: simulated time of ``discs``.
         run_id: identifies the run, so that a resumed run appends only to its own log.
         base: physical events the run had processed before the log starts.
+        ids: ``(N,)`` the discs' ids (``sim.ids``), stored only when given (None: their indices).
     """
     meta = {
         "kind": STREAM_KIND,
@@ -47,6 +50,8 @@ def stream_header(discs: Discs, box: Box, start_time: float, run_id: str, base: 
         "masses": discs.masses,
         "groups": discs.groups,
     }
+    if ids is not None:
+        arrays["ids"] = np.asarray(ids, dtype=np.int64)
     return meta, arrays
 
 
@@ -62,6 +67,7 @@ class StreamedEvents:
         end_time: simulated time up to which the log is complete (the run's
             time when it last wrote to the log).
         run_id: the run that wrote the log.
+        ids: ``(N,)`` the ids of ``discs`` (the names the records give them), or None: their indices.
     """
 
     events: np.ndarray
@@ -70,11 +76,14 @@ class StreamedEvents:
     start_time: float
     end_time: float
     run_id: str
+    ids: np.ndarray | None = None
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
-        """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``.
+        """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
 
-        ``unwrapped=True`` follows each disc across the edges of a periodic box.
+        ``unwrapped=True`` follows each disc across the edges of a periodic box. Without added or removed
+        discs (``add_discs``, ``remove_discs``) ``M = N``; else see ``Engine.trajectory``: NaN where a disc
+        was not there.
 
         Raises:
             TimeError: if a time is not finite or lies outside the logged span.
@@ -88,6 +97,7 @@ class StreamedEvents:
             times,
             span="logged span",
             unwrapped=unwrapped,
+            ids=self.ids,
         )
 
 
@@ -137,10 +147,14 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
         start_time = float(meta["start_time"])
         end_time = float(stream.last.get("time", start_time))
         run_id = str(meta["run_id"])
+        ids = arrays.get("ids")
+        if ids is not None and np.shape(ids) != (len(discs),):
+            msg = f"ids of shape {np.shape(ids)} for {len(discs)} discs"
+            raise TypeError(msg)
     except (KeyError, TypeError, DiscsimError) as exc:
         msg = f"{path}: the event log's header is incomplete or invalid ({exc})"
         raise CheckpointError(msg) from exc
-    return StreamedEvents(stream.records, discs, box, start_time, end_time, run_id)
+    return StreamedEvents(stream.records, discs, box, start_time, end_time, run_id, ids)
 
 
 def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndarray:

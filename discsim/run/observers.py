@@ -188,13 +188,13 @@ class EventStream(Observer):
             return
         from_start = stream is None and len(engine._log) == logged  # the log in memory covers the whole run
         if from_start:
-            discs, start, base = engine.discs, engine.start_time, 0
+            (discs, ids), start, base = engine._log_origin(), engine.start_time, 0
             self._hold(engine._log.since(0))
-        else:
-            discs, start, base = engine.snapshot(), engine.time, logged  # earlier events stay out of this file
+        else:  # earlier events stay out of this file
+            discs, ids, start, base = engine.snapshot(), engine._ids, engine.time, logged
         if engine._run_id is None:
             engine._run_id = uuid.uuid4().hex
-        meta, arrays = stream_header(discs, engine.box, start, engine._run_id, base)
+        meta, arrays = stream_header(discs, engine.box, start, engine._run_id, base, ids)
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
         self._created = True
         engine._stream = {

@@ -23,6 +23,7 @@ from discsim.analysis.dynamics import free_times_of
 from discsim.analysis.frames import Frames, states_at
 from discsim.analysis.thermo import VirialBlocks
 from discsim.errors import InvalidArgumentError
+from discsim.events import ADD, REMOVE
 from discsim.run.observers import Observer
 
 __all__ = ["GSDWriter", "Sampler"]
@@ -117,8 +118,18 @@ class Sampler(Observer):
                 "it moved outside run(..., observers=[sampler]) and the sampler missed those events"
             )
             raise InvalidArgumentError(msg)
+        if self._state is not None and engine._structure != self._structure:
+            raise InvalidArgumentError(self._changed_message(engine.time))
+
+    @staticmethod
+    def _changed_message(time: float) -> str:
+        return (
+            f"a Sampler follows a fixed set of discs, and discs were added or removed (add_discs / remove_discs) "
+            f"at time {time!r}; sample each span between changes with its own Sampler"
+        )
 
     def start(self, engine, plan) -> None:
+        self._structure = engine._structure
         if self._engine_id is None:
             self._engine_id = id(engine)
             self._origin = engine.time
@@ -133,6 +144,9 @@ class Sampler(Observer):
         return SAMPLE_CHUNK
 
     def update(self, engine, events, done, finishing) -> None:
+        changed = np.flatnonzero((events["kind"] == ADD) | (events["kind"] == REMOVE))
+        if len(changed):  # a callback changed the discs: the samples after it would be wrong
+            raise InvalidArgumentError(self._changed_message(float(events["time"][changed[0]])))
         self.virial_blocks.add(events, engine.time)
         if self._collect_free:
             masses = self.virial_blocks.masses

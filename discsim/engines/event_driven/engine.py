@@ -16,6 +16,7 @@ from discsim._numba import resolve_backend
 from discsim.cells import CellGrid, neighbour_pairs
 from discsim.engines.base import Engine
 from discsim.engines.event_driven.numba import NumbaBackend
+from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.protocol import Backend
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
@@ -193,6 +194,25 @@ class EventDriven(Engine):
         for k, i in enumerate(indices.tolist()):
             vx, vy = velocities[k].tolist()
             set_disc(i, vx, vy, None if positions is None else tuple(positions[k].tolist()))
+
+    def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None:
+        """A fresh start at ``time`` from the discs of ``scene`` (``keep``, then ``added``): new cell grid, new
+        backend, every disc predicted, as ``EventDriven(scene.discs, box)`` would start (its times then
+        shifted by ``time``: the internal clock's epoch is ``time``). The counters, the virial and the
+        images of the kept discs (so ``unwrapped_positions`` stay continuous) carry over."""
+        old, box = self._backend, self.box
+        grid = self.cell_grid(scene.discs.radii, box, self.cell_size)  # may refuse the new discs: nothing changed
+        backend = BACKENDS[old.name](scene, grid, self.queue_kind)
+        state = fresh_state(scene, grid)
+        state.time = state.epoch = old.time
+        for name, value in old.counts().items():
+            setattr(state, name, value)
+        state.virial, state.max_overlap, state.max_queue = old.virial, old.max_overlap, old.max_queue
+        if box.periodic and len(keep):
+            unwrapped = old.unwrapped_positions()[keep]
+            state.images[: len(keep)] = np.round((unwrapped - scene.discs.positions[: len(keep)]) / box.size)
+        backend.start(state)
+        self.grid, self._backend, self._jam_mark = grid, backend, None
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None

@@ -35,8 +35,10 @@ class Backend(Protocol):
     @property
     def virial(self) -> float: ...
 
-    def start(self) -> None:
-        """A fresh run at time 0 from the scene's discs."""
+    def start(self, state: EventDrivenState | None = None) -> None:
+        """A fresh run at time 0 from the scene's discs, or from ``state`` (a fresh state with an empty queue,
+        from :func:`~discsim.engines.event_driven.numbering.fresh_state`, its clock moved on): every moving
+        disc predicted at the state's epoch, in internal order."""
 
     def load(self, state: EventDrivenState) -> None:
         """Take over ``state``."""

@@ -27,6 +27,7 @@ state, so a run saved under one continues under the other.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -191,10 +192,6 @@ class FixedStep(Engine):
         from :meth:`_load`.
         """
         super().__init__(scene, record)
-        shapes = Shapes(scene)
-        # The same box check as EventDriven's cell grid (a periodic box needs 3 cells a side);
-        # max_cells=9 keeps the throw-away grid tiny.
-        CellGrid(scene.box, shapes.diameter, max_cells=9)
         self.frame_rate = frame_rate
         self.dt = dt
         self._by_rate = by_rate  # frame k at k / frame_rate, else at k * dt
@@ -202,16 +199,47 @@ class FixedStep(Engine):
         self.broad_phase = broad_phase
         self.bisect_tol = bisect_tol
         self.backend = backend
-        self._shapes = shapes
-        self._broad = BROAD_PHASE_CLASSES[broad_phase](shapes)
-        if backend == "numba":
+        self._shapes, self._broad, self._policy = self._parts(scene)
+
+    def _parts(self, scene: Scene) -> tuple:
+        """``(shapes, broad phase, policy)`` for the discs of ``scene`` (options set already)."""
+        shapes = Shapes(scene)
+        # The same box check as EventDriven's cell grid (a periodic box needs 3 cells a side);
+        # max_cells=9 keeps the throw-away grid tiny.
+        CellGrid(scene.box, shapes.diameter, max_cells=9)
+        broad = BROAD_PHASE_CLASSES[self.broad_phase](shapes)
+        if self.backend == "numba":
             from discsim.engines.fixed_step.numba.policy import CompiledFrame  # numba loads only when asked for
 
-            self._policy = CompiledFrame(policy, shapes, self._broad)
-        elif policy == "bisect":
-            self._policy = Bisect(shapes, self._broad, bisect_tol)
-        else:
-            self._policy = _POLICY_CLASSES[policy](shapes, self._broad)
+            return shapes, broad, CompiledFrame(self.policy, shapes, broad)
+        if self.policy == "bisect":
+            return shapes, broad, Bisect(shapes, broad, self.bisect_tol)
+        return shapes, broad, _POLICY_CLASSES[self.policy](shapes, broad)
+
+    def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None:
+        """Go on with discs ``keep`` and then ``added`` (new at ``time``, as if set there: their frame
+        positions are where they are added), on the frame grid as before; the Verlet list is rebuilt at the
+        next frame."""
+        parts = self._parts(scene)  # may refuse the new discs: nothing changed
+        state = self.state()
+        arrays = {name: getattr(state, name)[keep] for name in ("ref_positions", "velocities", "ref_times")}
+        arrays.update(images=state.images[keep], frame_positions=state.frame_positions[keep])
+        if added is not None:
+            k, t = len(added), self.time
+            for name, rows in (
+                ("ref_positions", added.positions),
+                ("velocities", added.velocities),
+                ("ref_times", np.full(k, t)),
+                ("images", np.zeros((k, 2), dtype=np.int64)),
+                ("frame_positions", added.positions),
+            ):
+                arrays[name] = np.concatenate([arrays[name], rows])
+        empty = np.zeros(0, dtype=np.int64)
+        state = dataclasses.replace(state, **arrays, list_positions=np.zeros((0, 2)), list_i=empty, list_j=empty)
+        self._shapes, self._broad, self._policy = parts
+        self.scene, self.discs = scene, scene.discs
+        self._load(state)
+        self._broad.load(state.list_positions, state.list_i, state.list_j, built=False)
 
     def _initial_state(self) -> FixedStepState:
         discs = self.discs
@@ -326,7 +354,8 @@ class FixedStep(Engine):
             arrays[name] = array
         self._paths = Paths(self.box, **arrays)
         self._tally = Tally(state.counts, state.max_overlap, state.virial)
-        self._broad.load(state.list_positions, state.list_i, state.list_j, built=state.list_builds > 0)
+        built = state.list_builds > 0 and len(state.list_positions) == n  # not after add_discs / remove_discs
+        self._broad.load(state.list_positions, state.list_i, state.list_j, built=built)
         self._frame_time = float(state.frame_time)
         self.time = float(state.time)
 

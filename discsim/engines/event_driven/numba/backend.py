@@ -74,10 +74,13 @@ class NumbaBackend:
         self._events = None
 
     # --- the protocol --------------------------------------------------------------------
-    def start(self) -> None:
-        """A fresh run at time 0 from the scene's discs: every moving disc predicted, in internal order."""
-        self.load(fresh_state(self.scene, self.grid))
+    def start(self, state: EventDrivenState | None = None) -> None:
+        """A fresh run at time 0 from the scene's discs (or from ``state``, a fresh state with an empty queue
+        whose clock moved on): every moving disc predicted at the epoch, in internal order."""
+        self.load(fresh_state(self.scene, self.grid) if state is None else state)
+        carried = int(self._ints[self._lp.I_MAXQ])
         self._lp.predict_all(*self._predict_args())
+        self._ints[self._lp.I_MAXQ] = max(carried, int(self._ints[self._lp.I_MAXQ]))
 
     def load(self, state: EventDrivenState) -> None:
         """Take over ``state`` (caller's numbering), building the internal arrays from it."""

@@ -89,14 +89,15 @@ class PythonBackend:
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
 
     # --- the protocol --------------------------------------------------------------------
-    def start(self) -> None:
-        """A fresh run at time 0 from the scene's discs: every moving disc predicted, in internal order."""
-        self.load(fresh_state(self.scene, self.grid))
+    def start(self, state: EventDrivenState | None = None) -> None:
+        """A fresh run at time 0 from the scene's discs (or from ``state``, a fresh state with an empty queue
+        whose clock moved on): every moving disc predicted at the epoch, in internal order."""
+        self.load(fresh_state(self.scene, self.grid) if state is None else state)
         predict, moving = self._predict, self._moving
         for i in range(len(moving)):
             if moving[i]:
                 predict(i, 0.0, -1)
-        self.max_queue = len(self._queue)
+        self.max_queue = max(self.max_queue, len(self._queue))
 
     def load(self, state: EventDrivenState) -> None:
         """Take over ``state`` (caller's numbering), building the fast internal forms from it."""

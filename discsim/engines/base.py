@@ -41,6 +41,7 @@ from discsim.errors import (
 )
 from discsim.events import EVENT_DTYPE, EventLog
 from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, kinetic_energy, momentum
+from discsim.repair import Repair, restart_scene
 from discsim.scene import Scene, check_added
 from discsim.trajectory import positions_from_log
 
@@ -609,6 +610,66 @@ class Engine(ABC):
         if not self.record:
             return np.zeros(0, dtype=EVENT_DTYPE)
         return self._log.to_array()
+
+    #: The moves that made this engine's start valid (:class:`~discsim.repair.Repair`), when it was built by
+    #: ``from_snapshot(..., repair="push")``; None otherwise. Not saved in checkpoints.
+    repair: Repair | None = None
+
+    @classmethod
+    def from_snapshot(
+        cls, source, box: Box | None = None, *, repair: str = "refuse", segments=None, pass_through=None, **options
+    ):
+        """A new engine of this class, started from ``source``'s discs as they are now, repaired if asked.
+
+        A fixed-step run answers overlaps after the fact, so its state may hold overlapping pairs and discs
+        cut by a wall or a segment, which the constructors refuse. ``repair`` says what happens to them:
+
+        - ``"refuse"`` (the default): raise, naming every such disc (the deepest ten of each kind) and how
+          deep it reaches, before anything is built;
+        - ``"push"``: move them the least needed (:func:`discsim.repair.push_apart`: an overlapping pair
+          apart along its line of centres, each disc in inverse proportion to its mass; a cut disc along
+          the normal until it touches the wall or segment), every velocity unchanged; ``sim.repair``
+          (:class:`~discsim.repair.Repair`) then says how far each disc moved.
+
+        A valid snapshot (any event-driven one) starts as it is under both. The new engine starts at time 0,
+        as one built from discs does (``source.time`` is where the source was), with an empty log.
+
+        Args:
+            source: an engine (its ``snapshot()`` at its ``time``, its box, segments and collision filter)
+                or :class:`~discsim.model.Discs` (then give ``box``).
+            box: the box of ``Discs``; with an engine, leave it out (or give the engine's own).
+            repair: ``"refuse"`` or ``"push"``.
+            segments, pass_through: with ``Discs``, as for the constructor (default none); with an
+                engine, its own (giving them too is an error).
+            **options: the constructor's other options (``record``, ``backend``; ``dt``, ``policy``, ...).
+
+        Returns:
+            The engine, at time 0.
+
+        Raises:
+            InvalidArgumentError: an unknown ``repair``, ``Discs`` without a box, or a box, segments or
+                filter given with an engine (the snapshot restarts in its own).
+            WrongTypeError: a ``source`` that is neither an engine nor ``Discs``.
+            OverlapError, OutsideBoxError: with ``"refuse"``, naming the overlapping pairs and the cut discs
+                with their depths; with ``"push"``, what no move repairs (two obstacles overlapping, an
+                obstacle cut by a wall, a disc centred on a segment, no room in the box). Nothing is built.
+
+        Example:
+            >>> import discsim as ds
+            >>> discs = ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], radii=1.0)
+            >>> coarse = ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=1.25).run(until=2.5)  # found 1 apart
+            >>> ds.EventDriven.from_snapshot(coarse)  # doctest: +ELLIPSIS
+            Traceback (most recent call last):
+            ...
+            discsim.errors.OverlapError: the snapshot of FixedStep at time 2.5 ...: discs 0 and 1 by 1 overlap ...
+            >>> sim = ds.EventDriven.from_snapshot(coarse, repair="push")
+            >>> sim.repair.displacements.tolist(), sim.velocities.tolist()
+            ([[-0.5, 0.0], [0.5, 0.0]], [[-1.0, 0.0], [1.0, 0.0]])
+        """
+        discs, box, segments, pass_through, report = restart_scene(source, box, segments, pass_through, repair)
+        sim = cls(discs, box, segments=segments, pass_through=pass_through, **options)
+        sim.repair = report
+        return sim
 
     def snapshot(self) -> Discs:
         """The discs as they are now: a new :class:`~discsim.model.Discs` at ``time``.

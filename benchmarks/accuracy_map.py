@@ -1,6 +1,6 @@
 """Accuracy map: when is PIT good enough? Missed collisions, direction error and delay over step and density.
 
-Run ``python benchmarks/accuracy_map.py`` (several minutes) or ``--quick`` (seconds).
+Run ``python benchmarks/accuracy_map.py`` (several minutes the first time) or ``--quick`` (seconds).
 
 The study concludes that PIT "may be acceptable where the frame rate is high
 and the objects are not very small", so that each moves only a little per
@@ -40,17 +40,29 @@ and every smaller step are good. A cell pools about ``3 N`` collisions, so 1%
 missed is about a dozen collisions: read the boundary to within a grid step.
 
 ``swept`` tests one periodic image per pair, so in a periodic box it refuses
-frames whose relative sweeps could reach a second image: not reached in the
-full map (box sides from 46 radii); the quick mode's small boxes reach it at
-``s = 10``, and those cells are left grey ("refused"), counted as not good.
+frames whose relative sweeps could reach a second image (``2 v_max dt + 2 r``
+at least half the box side): in the full map at ``s = 10`` from packing 0.1 up
+and at ``s = 4.6`` from 0.45 up (7 cells), in the quick mode's small boxes at
+``s = 10``; those cells are left grey ("refused"), counted as not good.
 
 A PIT run that exceeds the per-cell time budget (the ``swept`` policy at large
 steps in dense gases follows thousands of collisions per frame) is stopped and
 its cell left grey, counted as not good.
 
+The map is one sweep, :func:`discsim.sweep` of :func:`discsim.tasks.pit_accuracy` over policies x steps x
+packing fractions and the seeds 1, 2 and 3, on a local process pool (one worker per core); each task makes
+its gas, equilibrates it, runs PIC (the truth, to its own horizon) and PIT, and returns counts and sums that
+:func:`pool` adds up over the seeds with pandas. The sweep is cached and resumable: every finished cell and
+seed is stored in ``results/cache/accuracy_map/`` (``accuracy_map_quick/`` for ``--quick``), so a rerun
+reads the map back in seconds, and a run that was stopped or killed computes only the cells it had not
+finished. Delete that folder to measure again (the cache key holds discsim's version, not the commit; cells
+over budget are stored as such too). The table has no per-cell PIT time: the tasks return only what repeats
+bit for bit; the sweep's wall time is printed.
+
 Output: ``accuracy_map.csv`` (one row per policy and cell),
 ``accuracy_map_boundary.csv`` and ``accuracy_map.png`` in ``--results``.
-The full run takes about eight minutes on two busy cores.
+The full run takes about seven minutes on two busy cores (load 4-5; eight and a half before it was a
+sweep, one gas after another in one process), and seconds once cached.
 """
 
 from __future__ import annotations
@@ -61,32 +73,20 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from benchutils import (
-    Column,
-    TimeLimitExceeded,
-    announce,
-    format_table,
-    load_average,
-    machine_summary,
-    parse_args,
-    time_limit,
-    timed,
-    write_csv,
-)
+from benchutils import Column, format_table, load_average, machine_summary, parse_args, timed, write_csv
 
 import discsim as ds
 
 #: Response policies (those this discsim has), one row of panels each.
 POLICIES = tuple(p for p in ("resolve", "revert", "separate", "bisect", "swept") if p in ds.POLICIES)
-#: Units: radius 1 and kT = 1/2 with mass 1, so the rms speed is 1 and dt = s.
+#: Units (those of :func:`discsim.tasks.pit_accuracy`): radius 1 and kT = 1/2 with mass 1, so the rms speed
+#: is 1 and dt = s.
 RADIUS = 1.0
 TEMPERATURE = 0.5
 V_RMS = math.sqrt(2.0 * TEMPERATURE)
 #: The good region: at most this missed fraction and this mean direction error (degrees).
 MISSED_LIMIT = 0.01
 ANGLE_LIMIT = 1.0
-#: PIT frames run past the horizon before comparing.
-MARGIN_FRAMES = 1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -136,111 +136,30 @@ QUICK = Config(
 )
 
 
-# --- one packing fraction ----------------------------------------------------------------
-@dataclasses.dataclass(frozen=True)
-class Gas:
-    """An equilibrated gas, its mean free time and the PIC run that is the truth for every step.
-
-    Attributes:
-        packing_fraction: eta. seed: its seed. discs: the start. box: the periodic box.
-        free_time: ``1 / rate`` from Enskog's collision rate (time units).
-        truth: PIC from ``discs``, run past every PIT run's end.
-        pic_seconds: wall-clock seconds of that PIC run.
+# --- the sweep -------------------------------------------------------------------------------
+def grid(config: Config) -> dict:
+    """The sweep's grid: every packing fraction, policy and step (the map's rows in that order); the run
+    lengths and the budget fixed.
     """
-
-    packing_fraction: float
-    seed: int
-    discs: ds.Discs
-    box: ds.Box
-    free_time: float
-    truth: ds.EventDriven
-    pic_seconds: float
-
-
-def horizon(free_time: float, dt: float, config: Config) -> float:
-    """``config.free_times`` mean free times, rounded up to whole frames of ``dt`` (at least one)."""
-    return max(1, math.ceil(config.free_times * free_time / dt - 1e-9)) * dt
+    return {
+        "packing_fraction": list(config.fractions),
+        "policy": list(config.policies),
+        "step": list(config.steps),
+        "n": config.n,
+        "free_times": config.free_times,
+        "equilibrate": config.equilibrate_per_disc,
+        "budget": config.budget_s,
+    }
 
 
-def make_gas(packing_fraction: float, seed: int, config: Config) -> Gas:
-    """Equilibrate a periodic gas and run PIC past the longest comparison any step needs."""
-    discs, box = ds.random_gas(
-        config.n, packing_fraction, periodic=True, seed=seed, temperature=TEMPERATURE, radius=RADIUS
+def measure_all(config: Config, cache: Path):
+    """Every policy, step and packing fraction for every seed (``ds.sweep``, cached): one row per task."""
+    return ds.sweep(
+        ds.tasks.pit_accuracy, grid(config), seeds=list(config.seeds), cache=cache, retries=1, progress=True
     )
-    start = ds.EventDriven(discs, box, record=False).run(events=round(config.equilibrate_per_disc * config.n))
-    discs = start.snapshot()
-    free_time = 1.0 / float(ds.enskog_collision_rate(packing_fraction, radius=RADIUS, kT=TEMPERATURE))
-    end = max(horizon(free_time, dt_of(s), config) + MARGIN_FRAMES * dt_of(s) for s in config.steps)
-    run = timed(lambda: ds.EventDriven(discs, box).run(until=end))
-    return Gas(packing_fraction, seed, discs, box, free_time, run.result, run.wall)
 
 
-def dt_of(step: float) -> float:
-    """The frame interval of the step ``s = v dt / r``."""
-    return step * RADIUS / V_RMS
-
-
-def measure(gas: Gas, policy: str, step: float, config: Config) -> dict:
-    """One gas and cell: PIT with ``policy`` at step ``s`` against PIC, on PIC's collisions in ``[0, H]``.
-
-    Returns:
-        Counts and sums (see :func:`errors_up_to`), ``seconds`` of the PIT run,
-        and ``status``: ``"ok"`` or why the cell has no numbers.
-    """
-    dt = dt_of(step)
-    until = horizon(gas.free_time, dt, config)
-    try:
-        with time_limit(config.budget_s):
-            run = timed(
-                lambda: ds.FixedStep(gas.discs, gas.box, dt=dt, policy=policy).run(until=until + MARGIN_FRAMES * dt)
-            )
-    except TimeLimitExceeded:
-        return {"status": f"over budget ({config.budget_s:g} s)"}
-    except ValueError as exc:  # swept refuses frames whose sweeps could wrap a small periodic box
-        return {"status": f"refused: {exc}"}
-    pit = run.result
-    return {
-        "status": "ok",
-        "seconds": run.wall,
-        "frames": pit.frames,
-        "pair_tests": pit.counts["pair_tests"],
-        **errors_up_to(gas, pit, until),
-    }
-
-
-def errors_up_to(gas: Gas, pit: ds.FixedStep, until: float) -> dict:
-    """Counts and sums of PIT's errors on PIC's collisions in ``[0, until]`` (pooled later over seeds).
-
-    Returns:
-        ``truth_collisions``, ``matched``, ``missed``, ``spurious``;
-        ``angle_count``, ``angle_sum`` and ``angle_max`` of the outgoing
-        direction errors (degrees) where defined; ``delay_count``,
-        ``abs_delay_sum`` (time units) and ``delay_sum_frames`` (signed, in
-        frames) of the matched collisions; ``max_overlap``.
-    """
-    report = ds.compare(gas.truth, pit, times=[until])
-    events = gas.truth.events
-    within = np.array([m[2] <= until for m in report.matches], dtype=bool).reshape(-1)
-    delays = report.delays[within] if within.size else np.zeros(0)
-    angles = report.direction_errors[within] if within.size else np.zeros((0, 2))
-    angles = angles[np.isfinite(angles)]
-    return {
-        "truth_collisions": int(np.sum((events["kind"] == 0) & (events["time"] <= until))),
-        "matched": int(within.sum()),
-        "missed": sum(1 for *_, t in report.missed_collisions if t <= until),
-        "spurious": sum(1 for *_, t in report.spurious_collisions if t <= until),
-        "angle_count": int(angles.size),
-        "angle_sum": float(angles.sum()),
-        "angle_max": float(angles.max()) if angles.size else math.nan,
-        "delay_count": int(delays.size),
-        "abs_delay_sum": float(np.abs(delays).sum()),
-        "delay_sum_frames": float(delays.sum()) / pit.dt,
-        "max_overlap": report.max_overlap,
-    }
-
-
-_SUMMED = (
-    "seconds",
+_SUMMED = [
     "frames",
     "pair_tests",
     "truth_collisions",
@@ -252,75 +171,58 @@ _SUMMED = (
     "delay_count",
     "abs_delay_sum",
     "delay_sum_frames",
-)
+]
 
 
-def pool(gases: list[Gas], policy: str, step: float, cells: list[dict], config: Config) -> dict:
-    """One row of the map: the cells of every seed of one packing fraction pooled.
+def pool(table, config: Config) -> list[dict]:
+    """One row of the map per policy, packing fraction and step: its seeds pooled (the sums and counts added).
 
-    Fractions are of all PIC collisions of the seeds together; means are over
-    all matched collisions; ``seconds`` is the mean PIT run time per seed.
+    Fractions are of all PIC collisions of the seeds together; means are over all matched collisions;
+    ``frames`` is per seed. A cell with a seed not measured (over budget, refused, or failed) has no numbers.
     """
-    gas = gases[0]
-    dt = dt_of(step)
-    row = {
-        "policy": policy,
-        "packing_fraction": gas.packing_fraction,
-        "step": step,
-        "dt": dt,
-        "horizon": horizon(gas.free_time, dt, config),
-        "free_time": gas.free_time,
-        "frames_per_free_time": gas.free_time / dt,
-        "seeds": len(cells),
-    }
-    failed = [c["status"] for c in cells if c["status"] != "ok"]
-    if failed:
-        return {**row, "status": failed[0]}
-    total = {key: sum(c[key] for c in cells) for key in _SUMMED}
-    truth, angles, delays = total["truth_collisions"], total["angle_count"], total["delay_count"]
-    missed_fraction = total["missed"] / truth if truth else math.nan
-    mean_angle = total["angle_sum"] / angles if angles else math.nan
-    row.update(
-        status="ok",
-        seconds=total["seconds"] / len(cells),
-        frames=total["frames"] // len(cells),
-        pair_tests=total["pair_tests"],
-        truth_collisions=truth,
-        collisions_per_disc=2.0 * truth / (len(cells) * len(gas.discs)),
-        matched=total["matched"],
-        missed=total["missed"],
-        spurious=total["spurious"],
-        missed_fraction=missed_fraction,
-        spurious_fraction=total["spurious"] / truth if truth else math.nan,
-        mean_direction_error_deg=mean_angle,
-        max_direction_error_deg=max((c["angle_max"] for c in cells if c["angle_count"]), default=math.nan),
-        mean_abs_delay_free_times=total["abs_delay_sum"] / delays / gas.free_time if delays else math.nan,
-        mean_delay_frames=total["delay_sum_frames"] / delays if delays else math.nan,
-        max_overlap=max(c["max_overlap"] for c in cells),
-        good=bool(missed_fraction <= MISSED_LIMIT and mean_angle <= ANGLE_LIMIT),
-    )
-    return row
-
-
-def measure_all(config: Config) -> tuple[list[dict], list[Gas]]:
-    """Every policy and step at every packing fraction, pooled over the seeds; returns the rows and the gases."""
-    rows, all_gases = [], []
-    for eta in config.fractions:
-        gases = [make_gas(eta, seed, config) for seed in config.seeds]
-        all_gases += gases
-        announce(
-            f"  eta={eta:g}: t_free={gases[0].free_time:.3g}, PIC of {len(gases)} seed(s) to "
-            f"t={gases[0].truth.time:.3g} ({sum(g.truth.counts['collisions'] for g in gases):,} collisions) "
-            f"in {sum(g.pic_seconds for g in gases):.2f} s"
+    table = table.assign(status=table["status"].where(table["error"].isna(), "failed: " + table["error"]))
+    rows = []
+    for (eta, policy, step), cells in table.groupby(["packing_fraction", "policy", "step"], sort=False):
+        first = cells.iloc[0]
+        dt, free_time = step * RADIUS / V_RMS, float(first["free_time"])
+        row = {
+            "policy": policy,
+            "packing_fraction": float(eta),
+            "step": float(step),
+            "dt": dt,
+            "horizon": float(first["horizon"]),
+            "free_time": free_time,
+            "frames_per_free_time": free_time / dt,
+            "seeds": len(cells),
+        }
+        failed = [status for status in cells["status"] if status != "ok"]
+        if failed:
+            rows.append({**row, "status": failed[0]})
+            continue
+        total = {key: float(value) for key, value in cells[_SUMMED].sum().items()}  # plain floats for the CSV
+        truth, angles, delays = int(total["truth_collisions"]), int(total["angle_count"]), int(total["delay_count"])
+        missed_fraction = total["missed"] / truth if truth else math.nan
+        mean_angle = total["angle_sum"] / angles if angles else math.nan
+        row.update(
+            status="ok",
+            frames=int(total["frames"]) // len(cells),
+            pair_tests=int(total["pair_tests"]),
+            truth_collisions=truth,
+            collisions_per_disc=2.0 * truth / (len(cells) * config.n),
+            matched=int(total["matched"]),
+            missed=int(total["missed"]),
+            spurious=int(total["spurious"]),
+            missed_fraction=missed_fraction,
+            spurious_fraction=total["spurious"] / truth if truth else math.nan,
+            mean_direction_error_deg=mean_angle,
+            max_direction_error_deg=float(cells.loc[cells["angle_count"] > 0, "angle_max"].max()),
+            mean_abs_delay_free_times=total["abs_delay_sum"] / delays / free_time if delays else math.nan,
+            mean_delay_frames=total["delay_sum_frames"] / delays if delays else math.nan,
+            max_overlap=float(cells["max_overlap"].max()),
+            good=bool(missed_fraction <= MISSED_LIMIT and mean_angle <= ANGLE_LIMIT),
         )
-        for policy in config.policies:
-            pooled = [
-                pool(gases, policy, s, [measure(g, policy, s, config) for g in gases], config) for s in config.steps
-            ]
-            spent = sum(r.get("seconds", config.budget_s) for r in pooled) * len(gases)
-            announce(f"    {policy}: {spent:.1f} s of PIT")
-            rows += pooled
-    return rows, all_gases
+        rows.append(row)
+    return rows
 
 
 # --- the answer in numbers -----------------------------------------------------------------
@@ -530,7 +432,6 @@ CSV_KEYS = [
     "frames_per_free_time",
     "seeds",
     "status",
-    "seconds",
     "frames",
     "pair_tests",
     "truth_collisions",
@@ -557,15 +458,15 @@ BOUNDARY_KEYS = [
 ]
 
 
-def report(rows: list[dict], gases: list[Gas], config: Config) -> list[dict]:
+def report(rows: list[dict], config: Config) -> list[dict]:
     """Print the maps as tables and the boundary; return the boundary rows."""
     for eta in config.fractions:
-        mine = [g for g in gases if g.packing_fraction == eta]
-        per_disc = [r["collisions_per_disc"] for r in rows if r["packing_fraction"] == eta and r["status"] == "ok"]
+        mine = [r for r in rows if r["packing_fraction"] == eta]
+        per_disc = [r["collisions_per_disc"] for r in mine if r["status"] == "ok"]
+        spread = f"{min(per_disc):.2f} to {max(per_disc):.2f}" if per_disc else "-"
         print(
-            f"eta={eta:g}: mean free time {mine[0].free_time:.4g}; PIC collisions per disc in [0, H]: "
-            f"{min(per_disc):.2f} to {max(per_disc):.2f} (over the steps); PIC of {len(mine)} seed(s) to "
-            f"t={mine[0].truth.time:.4g}: {sum(g.pic_seconds for g in mine):.2f} s"
+            f"eta={eta:g}: mean free time {mine[0]['free_time']:.4g}; PIC collisions per disc in [0, H]: "
+            f"{spread} (over the steps)"
         )
     for policy in config.policies:
         print(f"\n== {policy}: missed collisions (%) ==")
@@ -584,23 +485,31 @@ def report(rows: list[dict], gases: list[Gas], config: Config) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    """Measure the map, print it, write the CSV files and the PNG; return the exit code."""
+    """Measure (or read back) the map, print it, write the CSV files and the PNG; return the exit code."""
     args = parse_args(__doc__.splitlines()[0], argv)
     config = QUICK if args.quick else FULL
+    cache = args.results / "cache" / ("accuracy_map_quick" if args.quick else "accuracy_map")
     print(f"discsim {ds.__version__} accuracy map; {machine_summary()}")
     print(
         f"mode: {'quick' if args.quick else 'full'}; periodic gas, N={config.n}, radius {RADIUS:g}, kT={TEMPERATURE:g} "
         f"(v_rms={V_RMS:g}, so dt = s); seeds {list(config.seeds)} pooled; horizon {config.free_times:g} mean free "
         "times in whole frames; "
-        f"policies {', '.join(config.policies)}; budget {config.budget_s:g} s per PIT run"
+        f"policies {', '.join(config.policies)}; budget {config.budget_s:g} s per PIT run; cache {cache}",
+        flush=True,
     )
-    run = timed(lambda: measure_all(config))
-    rows, gases = run.result
-    limits = report(rows, gases, config)
+    run = timed(lambda: measure_all(config, cache))
+    table = run.result
+    info = table.attrs["sweep"]
+    rows = pool(table, config)
+    limits = report(rows, config)
     csv_path = write_csv(args.results / "accuracy_map.csv", rows, CSV_KEYS)
     boundary_path = write_csv(args.results / "accuracy_map_boundary.csv", limits, BOUNDARY_KEYS)
     png = plot(rows, config, args.results / "accuracy_map.png")
-    print(f"\nmeasured in {run.wall:.0f} s; load average at the end: {load_average():.2f}")
+    print(
+        f"\nsweep of {info['tasks']} tasks on {info['where']}: {info['ran']} ran ({info['task_seconds']:.0f} s in "
+        f"them), {info['cached']} from the cache, {info['failed']} failed, {info['retries']} retried; "
+        f"{run.wall:.0f} s wall; load average at the end: {load_average():.2f}"
+    )
     print(f"wrote {csv_path}, {boundary_path}, {png}")
     return 0
 

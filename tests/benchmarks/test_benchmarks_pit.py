@@ -197,6 +197,58 @@ def test_accuracy_map_boundary_is_consistent_with_the_cells(accuracy_map):
             assert bad["good"] != "True"
 
 
+@pytest.mark.slow
+def test_accuracy_map_rerun_reads_its_cache(accuracy_map):
+    """The map is a cached sweep: a second run computes nothing and writes the same files."""
+    done, results = accuracy_map
+    assert done.returncode == 0, done.stderr
+    assert "sweep of 40 tasks" in done.stdout and "40 ran" in done.stdout
+    before = {name: (results / name).read_text() for name in ("accuracy_map.csv", "accuracy_map_boundary.csv")}
+    again = _run_quick("accuracy_map.py", results)
+    assert again.returncode == 0, again.stderr
+    assert "0 ran (0 s in them), 40 from the cache, 0 failed" in again.stdout
+    for name, text in before.items():
+        assert (results / name).read_text() == text
+
+
+def test_accuracy_map_pools_the_seeds(monkeypatch):
+    """pool() adds the counts and sums of the seeds; a seed not measured leaves the cell without numbers."""
+    import importlib.util
+
+    import pandas as pd
+
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    spec = importlib.util.spec_from_file_location("accuracy_map", BENCHMARKS / "accuracy_map.py")
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "accuracy_map", module)
+    spec.loader.exec_module(module)
+
+    def cell(seed, missed, angle_sum, status="ok", error=None):
+        return {
+            "packing_fraction": 0.3, "policy": "resolve", "step": 0.5, "seed": seed, "status": status,
+            "horizon": 4.0, "free_time": 2.0, "frames": 9, "pair_tests": 100, "truth_collisions": 50,
+            "matched": 50 - missed, "missed": missed, "spurious": 1, "angle_count": 50 - missed,
+            "angle_sum": angle_sum, "angle_max": angle_sum / 10, "delay_count": 50 - missed,
+            "abs_delay_sum": 0.5, "delay_sum_frames": 2.0, "max_overlap": 0.01 * seed, "error": error,
+        }  # fmt: skip
+
+    config = module.QUICK
+    rows = module.pool(pd.DataFrame([cell(1, 0, 10.0), cell(2, 2, 38.0)]), config)
+    assert len(rows) == 1
+    row = rows[0]
+    assert row["status"] == "ok" and row["seeds"] == 2
+    assert row["truth_collisions"] == 100 and row["missed"] == 2 and row["missed_fraction"] == 0.02
+    assert row["mean_direction_error_deg"] == pytest.approx(48.0 / 98)
+    assert row["max_direction_error_deg"] == pytest.approx(3.8) and row["max_overlap"] == pytest.approx(0.02)
+    assert row["frames"] == 9 and row["collisions_per_disc"] == 2.0 * 100 / (2 * config.n)
+    assert row["good"] is False  # 2% missed
+    assert type(row["missed_fraction"]) is float  # plain floats: the CSV writes repr()
+    failed = module.pool(pd.DataFrame([cell(1, 0, 1.0), cell(2, 0, 1.0, status=None, error="ValueError: x")]), config)
+    assert failed[0]["status"] == "failed: ValueError: x" and "missed_fraction" not in failed[0]
+    over = module.pool(pd.DataFrame([cell(1, 0, 1.0, status="over budget"), cell(2, 0, 1.0)]), config)
+    assert over[0]["status"] == "over budget"
+
+
 def test_accuracy_map_docstring_examples(monkeypatch):
     import doctest
     import importlib.util

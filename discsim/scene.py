@@ -113,7 +113,9 @@ def check_added(discs: Discs, box: Box, new_from: int, segments=(), pass_through
     Messages name each new disc by the index it would get.
 
     Raises:
-        UnitsError, OutsideBoxError, OverlapError.
+        UnitsError: a new radius does not resolve in the box.
+        OutsideBoxError: a new disc is outside the box or cut by a wall or segment.
+        OverlapError: a new disc overlaps another disc.
     """
     radii = discs.radii[new_from:]
     if len(radii):

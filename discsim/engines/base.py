@@ -284,11 +284,13 @@ class Engine(ABC):
 
         Raises:
             WrongTypeError: ``discs`` is not a ``Discs``.
-            OutsideBoxError, OverlapError: naming the new disc by the index it would get (and the disc it
-                would overlap). UnitsError: a radius or speed outside what discsim resolves.
-            BoxTooSmallError, InvalidArgumentError: the larger discs no longer fit the engine's cell grid
-                (a periodic box needs 3 cells of the largest diameter a side; ``cell_size`` below it).
-            Nothing changes then.
+            OutsideBoxError: a new disc is outside the box or cut by a wall or segment, named by the index it
+                would get. Nothing changes then, for this error and every one below.
+            OverlapError: a new disc would overlap a disc (named, with the other disc and the depth).
+            UnitsError: a radius or speed outside what discsim resolves.
+            BoxTooSmallError: the larger discs no longer fit a periodic box's cell grid (3 cells of the
+                largest diameter a side).
+            InvalidArgumentError: the larger discs no longer fit the engine's ``cell_size``.
 
         Example:
             >>> import discsim as ds

@@ -33,8 +33,8 @@ import numpy as np
 
 from discsim.cells import neighbour_pairs
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, WrongTypeError
-from discsim.model import OVERLAP_TOLERANCE, Box, Discs, Segment, normalize_pass_through
-from discsim.scene import filter_table
+from discsim.model import OVERLAP_TOLERANCE, Box, Discs, normalize_pass_through
+from discsim.scene import check_segments, filter_table
 
 __all__ = ["REPAIRS", "STOP", "Repair", "Violations", "push_apart", "restart_scene", "violations"]
 
@@ -217,15 +217,7 @@ def _checked(discs, box, segments, pass_through):
     if not isinstance(box, Box):
         msg = f"box must be a discsim.Box, got {type(box).__name__}"
         raise WrongTypeError(msg)
-    segments = tuple(segments)
-    for k, segment in enumerate(segments):
-        if not isinstance(segment, Segment):
-            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__} {segment!r}"
-            raise WrongTypeError(msg)
-    if segments and box.periodic:
-        msg = "segments need a box with walls (periodic=False)"
-        raise InvalidArgumentError(msg)
-    return discs, box, segments, normalize_pass_through(pass_through)
+    return discs, box, check_segments(segments, box), normalize_pass_through(pass_through)
 
 
 def _candidate_pairs(pos, discs, box, pass_through, reach):

@@ -130,6 +130,24 @@ def check_added(discs: Discs, box: Box, new_from: int, segments=(), pass_through
     check_fits(discs, box, segments=segments, pass_through=pass_through, new_from=new_from)
 
 
+def check_segments(segments, box: Box) -> tuple[Segment, ...]:
+    """``segments`` as a tuple, each a :class:`~discsim.model.Segment`, in a box with walls.
+
+    Raises:
+        WrongTypeError: naming the first that is not a ``Segment``.
+        InvalidArgumentError: if there are segments and the box is periodic.
+    """
+    segments = tuple(segments)
+    for k, segment in enumerate(segments):
+        if not isinstance(segment, Segment):
+            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__} {segment!r}"
+            raise WrongTypeError(msg)
+    if segments and box.periodic:
+        msg = "segments need a box with walls (periodic=False)"
+        raise InvalidArgumentError(msg)
+    return segments
+
+
 def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[tuple[Segment, ...], frozenset]:
     """Validate what an engine is given: segments, the collision filter, and :func:`check_fits`.
 
@@ -142,14 +160,7 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
         ValueError: if segments are given with a periodic box.
         OutsideBoxError, OverlapError: from :func:`check_fits`.
     """
-    segments = tuple(segments)
-    for k, segment in enumerate(segments):
-        if not isinstance(segment, Segment):
-            msg = f"segments[{k}] must be a discsim.Segment, got {type(segment).__name__} {segment!r}"
-            raise WrongTypeError(msg)
-    if segments and box.periodic:
-        msg = "segments need a box with walls (periodic=False)"
-        raise InvalidArgumentError(msg)
+    segments = check_segments(segments, box)
     for k, segment in enumerate(segments):
         if not _crosses_box(segment, box):
             msg = f"segments[{k}] {segment!r} lies entirely outside the box {box.width:g} x {box.height:g}"

@@ -1,6 +1,6 @@
 """Equation of state of hard discs: Z(eta) from 0.05 to 0.70 against Henderson's equation and the virial series.
 
-Run ``python benchmarks/equation_of_state.py`` (about five minutes on two cores the first time, instant once
+Run ``python benchmarks/equation_of_state.py`` (about four minutes on two cores the first time, seconds once
 cached) or ``--quick`` (seconds).
 
 One sweep (:func:`discsim.sweep` of :func:`discsim.tasks.equation_of_state`) over 12 packing fractions
@@ -20,13 +20,18 @@ means inside one run underestimate fluctuations slower than a block. ``residual_
 ``B_10``) in units of ``z_err``.
 
 Equilibration is checked at the dense end: 0.65, 0.68 and 0.70 are run again with four times the melting
-(2000 collisions per disc) and the two ``Z`` compared (``check_*`` columns). At 0.70 the hard-disc system
-is at the liquid side of its liquid-hexatic coexistence (Bernard and Krauth, PRL 107, 155704 (2011): the
-liquid ends at 0.700, the hexatic starts at 0.716, at ``beta P sigma^2 = 9.185``, that is ``Z = 10.3``):
-with N = 2000 its global ``psi6`` wanders between about 0.5 and 0.2 over thousands of collisions per disc,
-and ``Z`` with it (10.0 to 10.7 in windows of 50 collisions per disc), so the seeds scatter more than their
-batch-means errors say, and the error bar there is their scatter. Henderson's equation, fitted at lower
-densities, overestimates ``Z`` there by about 15%.
+(2000 collisions per disc) and the two ``Z`` compared (``check_*`` columns, the difference in combined error
+bars). At 0.70 the hard-disc system is at the liquid end of its liquid-hexatic coexistence (Bernard and
+Krauth, PRL 107, 155704 (2011): liquid up to 0.700, hexatic from 0.716, at ``beta P sigma^2 = 9.185``, that
+is ``Z = 10.3`` at 0.700). There a lattice start takes about 500 collisions per disc to lose its memory
+(``Z`` climbs from 10.0 to about 10.3 meanwhile), and afterwards the global ``psi6`` of N = 2000 discs
+wanders between about 0.5 and 0.1 over thousands of collisions per disc, with ``Z`` moving against it (10.0
+to 10.7 in windows of 50 collisions per disc): so each seed measures over 2000 collisions per disc, and the
+error bar at 0.70 is several times those around it. Measured (2026-11-24): 10.34 +- 0.03 with 500
+collisions per disc of melting, 10.28 +- 0.04 with 2000, both at Bernard and Krauth's 10.3. Henderson's
+equation, fitted to lower densities, is 12% above there (0.4% at 0.5, 1.2% at 0.6, 2.1% at 0.65); the
+virial series to ``B_10`` falls below from 0.4 on (0.6% at 0.5, 3% at 0.6, 6% at 0.65 and 0.68; 1% at
+0.70, where the measured ``Z`` bends over towards the coexistence plateau).
 
 Output: ``equation_of_state.csv`` (one row per packing fraction) and ``equation_of_state.png`` (``Z`` with
 error bars against both references, and the residuals in units of the error bar) in ``--results``.

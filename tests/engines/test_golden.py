@@ -63,7 +63,7 @@ def test_golden_log(name):
     assert_matches(sim, GOLDEN / f"{name}.npz")
 
 
-#: The fixed-step scenes whose policy has a compiled frame ("fs_<policy>_<scene>").
+#: The fixed-step scenes whose policy has a compiled frame ("fs_<policy>_<scene>"): all of them.
 FS_COMPILED = [name for name in SCENES if name.startswith("fs_") and name.split("_")[1] in COMPILED_POLICIES]
 
 

@@ -20,7 +20,7 @@ log and the frame clock, and hands each frame to its policy, which works on the 
 (:class:`~discsim.engines.fixed_step.arrays.Paths`). The run state is exported and loaded as a
 :class:`~discsim.engines.fixed_step.state.FixedStepState`.
 
-Two backends run the frames: ``"python"`` (numpy; the modules above) and ``"numba"`` (the frame policies
+Two backends run the frames: ``"python"`` (numpy; the modules above) and ``"numba"`` (every policy's frame
 compiled, :mod:`discsim.engines.fixed_step.numba`), which give the same frames bit for bit and the same
 state, so a run saved under one continues under the other.
 """
@@ -58,8 +58,8 @@ SUB_FRAME_POLICIES = tuple(SUB_FRAME_POLICY_CLASSES)
 BROAD_PHASES = tuple(BROAD_PHASE_CLASSES)
 #: Backends of :class:`FixedStep`'s frame.
 BACKENDS = ("python", "numba")
-#: The policies whose frame the ``"numba"`` backend compiles (the others run in Python under ``"auto"``).
-COMPILED_POLICIES = ("resolve", "revert", "separate")
+#: The policies whose frame the ``"numba"`` backend compiles: all of them.
+COMPILED_POLICIES = ("resolve", "revert", "separate", "bisect", "swept")
 
 #: Default frames per unit of time.
 DEFAULT_FRAME_RATE = 30.0
@@ -92,7 +92,7 @@ class FixedStep(Engine):
         bisect_tol: the ``"bisect"`` policy's tolerance on contact times (time
             units; default ``1e-6 * dt``).
         backend: what runs the frames: ``"auto"`` (the default: ``"numba"`` when numba
-            imports and the policy is one of :data:`COMPILED_POLICIES`, else ``"python"``),
+            imports, else ``"python"``),
             ``"numba"`` (the frame compiled, from the ``fast`` extra: ``pip install
             "discsim[fast]"``) or ``"python"`` (numpy). Both give the same frames bit for bit.
 
@@ -101,7 +101,7 @@ class FixedStep(Engine):
             not a positive finite number, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
             a periodic box, ``backend="numba"`` without numba (naming the extra to
-            install) or with a policy it does not compile (``"bisect"``, ``"swept"``).
+            install).
         TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
         InvalidDiscsError: on a malformed ``pass_through``.
         OutsideBoxError, OverlapError: if the discs do not fit in the box (or
@@ -209,9 +209,9 @@ class FixedStep(Engine):
         CellGrid(scene.box, shapes.diameter, max_cells=9)
         broad = BROAD_PHASE_CLASSES[self.broad_phase](shapes)
         if self.backend == "numba":
-            from discsim.engines.fixed_step.numba.policy import CompiledFrame  # numba loads only when asked for
+            from discsim.engines.fixed_step.numba.policy import compiled_policy  # numba loads only when asked for
 
-            return shapes, broad, CompiledFrame(self.policy, shapes, broad)
+            return shapes, broad, compiled_policy(self.policy, shapes, broad, self.bisect_tol)
         if self.policy == "bisect":
             return shapes, broad, Bisect(shapes, broad, self.bisect_tol)
         return shapes, broad, _POLICY_CLASSES[self.policy](shapes, broad)
@@ -369,6 +369,8 @@ class FixedStep(Engine):
             raise InvalidArgumentError(msg)
         done = 0
         batch = getattr(self._policy, "batch", 1)  # frames per call: the compiled frame does many at once
+        if callable(batch):  # as many as the policy can vouch for without a check before each frame
+            batch = batch(self._paths, self.dt)
         while done < todo:
             # Ctrl-C ends the run at a whole frame; a handler of the program's own may let it go on.
             with deferred_interrupt() as interrupted:

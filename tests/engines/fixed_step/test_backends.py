@@ -16,7 +16,10 @@ import pytest
 
 import discsim as ds
 from discsim import _numba
-from discsim.engines.fixed_step.engine import COMPILED_POLICIES
+from discsim.engines.fixed_step.engine import COMPILED_POLICIES, SUB_FRAME_POLICIES
+
+#: The policies that answer at the frame (the rest answer inside it).
+FRAME_POLICIES = tuple(p for p in COMPILED_POLICIES if p not in SUB_FRAME_POLICIES)
 
 needs_numba = pytest.mark.skipif(not _numba.available(), reason="numba is not installed (the fast extra)")
 
@@ -90,7 +93,7 @@ def assert_identical(a, b):
 # --- the same frames -----------------------------------------------------------------------------------
 @needs_numba
 @pytest.mark.parametrize("broad_phase", ["grid", "all-pairs"])
-@pytest.mark.parametrize("policy", COMPILED_POLICIES)
+@pytest.mark.parametrize("policy", FRAME_POLICIES)
 @pytest.mark.parametrize("scene", ["walled", "periodic"])
 def test_both_backends_give_the_same_frames_bit_for_bit(scene, policy, broad_phase):
     discs, box, options = SCENES[scene]()
@@ -106,20 +109,49 @@ def test_both_backends_give_the_same_frames_bit_for_bit(scene, policy, broad_pha
 
 
 @needs_numba
-@pytest.mark.parametrize("policy", COMPILED_POLICIES)
-def test_a_large_gas_gives_the_same_frames_and_the_same_verlet_list(policy):
-    discs, box, options = large()
-    runs = [ds.FixedStep(discs, box, policy=policy, backend=b, **options).run(frames=40) for b in ("python", "numba")]
-    assert runs[0].counts["list_builds"] >= 2
+@pytest.mark.parametrize("broad_phase", ["grid", "all-pairs"])
+@pytest.mark.parametrize("policy", SUB_FRAME_POLICIES)
+@pytest.mark.parametrize("scene", ["walled", "periodic"])
+def test_the_sub_frame_policies_give_the_same_frames_bit_for_bit(scene, policy, broad_phase):
+    """Chains of contacts inside frames, walls, a triangle of segments, obstacles, three radii and masses,
+    groups passing through each other: the same log, state and counters (bisection tests too)."""
+    discs, box, options = SCENES[scene]()
+    runs = [
+        ds.FixedStep(discs, box, policy=policy, broad_phase=broad_phase, backend=backend, **options).run(frames=120)
+        for backend in ("python", "numba")
+    ]
+    assert [sim.backend for sim in runs] == ["python", "numba"]
+    counts = runs[0].counts
+    assert counts["detections"] > 900 and counts["pair_tests"] > counts["detections"]
+    assert (counts["bisection_tests"] > 10 * counts["detections"]) == (policy == "bisect")
+    if scene == "walled":
+        assert counts["wall_hits"] > 300 and counts["segment_tests"] > 0
+        # Some disc met a segment: a hit that left it off every wall of the box.
+        hits = runs[0].events[runs[0].events["j"] < 0]
+        x, y = hits["xi"], hits["yi"]
+        r = discs.radii[hits["i"]]
+        inside = (x - r > 1e-9) & (x + r < box.width - 1e-9) & (y - r > 1e-9) & (y + r < box.height - 1e-9)
+        assert inside.any()
     assert_identical(*runs)
 
 
 @needs_numba
-def test_step_gives_the_python_frames_events_and_a_batch_of_frames_equals_single_frames():
+@pytest.mark.parametrize("policy", COMPILED_POLICIES)
+def test_a_large_gas_gives_the_same_frames_and_the_same_verlet_list(policy):
+    discs, box, options = large()
+    runs = [ds.FixedStep(discs, box, policy=policy, backend=b, **options).run(frames=40) for b in ("python", "numba")]
+    assert (runs[0].counts["list_builds"] >= 2) == (policy in FRAME_POLICIES)
+    assert runs[0].counts["detections"] > 500
+    assert_identical(*runs)
+
+
+@needs_numba
+@pytest.mark.parametrize("policy", ["separate", "bisect", "swept"])
+def test_step_gives_the_python_frames_events_and_a_batch_of_frames_equals_single_frames(policy):
     discs, box, options = walled()
-    python = ds.FixedStep(discs, box, policy="separate", backend="python", **options)
-    numba = ds.FixedStep(discs, box, policy="separate", backend="numba", **options)
-    batched = ds.FixedStep(discs, box, policy="separate", backend="numba", **options)
+    python = ds.FixedStep(discs, box, policy=policy, backend="python", **options)
+    numba = ds.FixedStep(discs, box, policy=policy, backend="numba", **options)
+    batched = ds.FixedStep(discs, box, policy=policy, backend="numba", **options)
     seen = 0
     for _ in range(60):
         events = python.step()
@@ -132,13 +164,48 @@ def test_step_gives_the_python_frames_events_and_a_batch_of_frames_equals_single
 
 
 @needs_numba
-def test_one_disc_and_two_discs_run_alike():
+@pytest.mark.parametrize("policy", COMPILED_POLICIES)
+def test_one_disc_and_two_discs_run_alike(policy):
     for discs in (
         ds.Discs([[3.0, 1.0]], [[2.0, 0.7]], 0.5),
         ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [0.0, 0.0]], radii=1.0, masses=[1.0, math.inf]),
     ):
-        runs = [ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=0.3, backend=b).run(until=20.0) for b in ("python", "numba")]
+        runs = [
+            ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=0.3, policy=policy, backend=b).run(until=20.0)
+            for b in ("python", "numba")
+        ]
+        assert runs[0].counts["wall_hits"] > 0
         assert_identical(*runs)
+
+
+@needs_numba
+@pytest.mark.parametrize("policy", SUB_FRAME_POLICIES)
+@pytest.mark.parametrize("scene", ["walled", "periodic"])
+def test_no_disc_runs_alike(policy, scene):
+    box = ds.Box(10.0, 10.0, periodic=scene == "periodic")
+    discs = ds.Discs(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
+    runs = [ds.FixedStep(discs, box, dt=0.3, policy=policy, backend=b).run(frames=5) for b in ("python", "numba")]
+    assert_identical(*runs)
+
+
+@needs_numba
+def test_pythons_square_is_the_c_librarys_pow_and_the_compiled_bisect_squares_alike():
+    """``x ** 2`` in Python is ``pow(x, 2.0)``, which differs from ``x * x`` in the last bit now and then;
+    the compiled ``bisect`` squares with ``pow`` and an exponent LLVM cannot see, so the tests agree."""
+    from discsim.engines.fixed_step.numba.sub_frame import BISECT, SEGMENT, _overlapping
+
+    rng = np.random.default_rng(3)
+    x = (rng.uniform(-1, 1, 20_000) * 10.0 ** rng.uniform(-6, 6, 20_000)).tolist()
+    assert any(v**2 != v * v for v in x)  # the test can tell the two apart
+    p = np.zeros(12)
+    for v in x[:3000]:
+        # A disc at rest at (v, 0), a segment along x = 0: overlapping when v ** 2 < r ** 2 = p[5].
+        p[:] = (v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0)
+        p[5] = v**2  # exactly at the edge under Python's square: no overlap
+        assert not _overlapping(SEGMENT, 0.0, p, False, 1.0, 1.0, 2.0), v
+        p[5] = np.nextafter(v**2, math.inf)
+        assert _overlapping(SEGMENT, 0.0, p, False, 1.0, 1.0, 2.0), v
+    assert BISECT == 3
 
 
 @needs_numba
@@ -186,11 +253,12 @@ def test_the_compiled_sort_of_the_overlapping_pairs_is_numpys():
 
 # --- checkpoints move between backends -----------------------------------------------------------------
 @needs_numba
+@pytest.mark.parametrize("policy", ["revert", "bisect", "swept"])
 @pytest.mark.parametrize(("first", "second"), [("python", "numba"), ("numba", "python")])
-def test_a_run_saved_under_one_backend_goes_on_under_the_other(tmp_path, first, second):
+def test_a_run_saved_under_one_backend_goes_on_under_the_other(tmp_path, first, second, policy):
     discs, box, options = walled()
-    whole = ds.FixedStep(discs, box, policy="revert", backend=second, **options).run(until=6.0)
-    half = ds.FixedStep(discs, box, policy="revert", backend=first, **options).run(until=3.0)
+    whole = ds.FixedStep(discs, box, policy=policy, backend=second, **options).run(until=6.0)
+    half = ds.FixedStep(discs, box, policy=policy, backend=first, **options).run(until=3.0)
     copy = ds.load(half.save(tmp_path / "half.dsc"), backend=second)
     assert copy.backend == second
     copy.run(until=6.0)
@@ -210,34 +278,93 @@ def test_a_checkpoint_of_the_compiled_frame_loads_where_numba_is_missing(tmp_pat
     assert_identical(whole, copy.run(frames=40))
 
 
+# --- refusals: the same error, at the same frame, the engine as usable ---------------------------------------
+def _fast_light_disc(dt):
+    """A periodic box where a heavy disc hits a light one at rest: the light one leaves at nearly twice
+    the heavy one's speed, too fast for ``"swept"`` at ``dt`` (2 v dt + 2 r >= half the box side)."""
+    discs = ds.Discs([[2.0, 5.0], [5.0, 5.0]], [[1.0, 0.0], [0.0, 0.0]], radii=0.5, masses=[100.0, 1.0])
+    return discs, ds.Box(10.0, 10.0, periodic=True)
+
+
 @needs_numba
-def test_a_sub_frame_run_loads_under_numba_in_python(tmp_path):
-    discs, box = ds.random_gas(40, 0.3, seed=4)
-    sim = ds.FixedStep(discs, box, dt=0.05, policy="bisect").run(frames=10)
-    copy = ds.load(sim.save(tmp_path / "bisect.dsc"), backend="numba")
-    assert copy.backend == "python" and copy.run(frames=10).frames == 20
+def test_swept_refuses_a_frame_that_could_reach_a_second_image_alike():
+    dt = 1.6  # 2 * 1.0 * 1.6 + 1 = 4.2 < 5 before the hit; 2 * 1.98 * 1.6 + 1 > 5 after it
+    discs, box = _fast_light_disc(dt)
+    runs, errors = [], []
+    for backend in ("python", "numba"):
+        sim = ds.FixedStep(discs, box, dt=dt, policy="swept", backend=backend)
+        with pytest.raises(ds.InvalidArgumentError, match=r"policy 'swept' in a periodic box needs") as caught:
+            sim.run(frames=10)
+        runs.append(sim)
+        errors.append(str(caught.value))
+    assert errors[0] == errors[1]
+    assert runs[0].frames == 2 and runs[0].counts["detections"] == 1  # the hit at t = 2, in frame 2
+    assert_identical(*runs)
+    for sim in runs:  # refused before the frame: the engine is still usable
+        assert sim.state() is not None and sim._broken is None
+    # Fast from the start: refused at the first frame, under either backend.
+    fast = ds.Discs([[2.0, 5.0]], [[4.0, 0.0]], radii=0.5)
+    messages = []
+    for backend in ("python", "numba"):
+        with pytest.raises(ds.InvalidArgumentError) as caught:
+            ds.FixedStep(fast, box, dt=dt, policy="swept", backend=backend).step()
+        messages.append(str(caught.value))
+    assert messages[0] == messages[1] and "use a smaller dt or a larger box" in messages[0]
+
+
+@needs_numba
+def test_swept_does_a_batch_of_frames_only_when_no_disc_can_get_too_fast():
+    from discsim.engines.fixed_step.numba.policy import BATCH_WORK
+
+    discs, box, options = periodic()
+    sim = ds.FixedStep(discs, box, policy="swept", backend="numba", **options)
+    assert sim._policy.batch(sim._paths, sim.dt) == BATCH_WORK // len(discs)  # energy bounds every speed
+    slow, box2 = _fast_light_disc(1.6)
+    risky = ds.FixedStep(slow, box2, dt=1.6, policy="swept", backend="numba")
+    assert risky._policy.batch(risky._paths, risky.dt) == 1  # the light disc could reach sqrt(2 E / m)
+    walled_sim = ds.FixedStep(*walled()[:2], policy="swept", backend="numba", dt=0.05)
+    assert walled_sim._policy.batch(walled_sim._paths, walled_sim.dt) > 1  # no images in a walled box
+
+
+@needs_numba
+@pytest.mark.parametrize("policy", SUB_FRAME_POLICIES)
+def test_a_jammed_frame_raises_the_same_error_with_the_same_log(policy):
+    from jams import JAMS, watchdog
+
+    discs, box, _ = JAMS["hexagonal_lattice"]()
+    runs, errors = [], []
+    for backend in ("python", "numba"):
+        sim = ds.FixedStep(discs, box, frame_rate=30, policy=policy, backend=backend)
+        with watchdog(60), pytest.raises(ds.JammedError, match=r"disc \d+ and disc \d+ are jammed") as caught:
+            sim.run(until=1.0)
+        runs.append(sim)
+        errors.append(str(caught.value))
+    assert errors[0] == errors[1]
+    python, numba = runs
+    assert len(python.events) > 1000
+    assert python.events.tobytes() == numba.events.tobytes()
+    # The counters of every response made, the frame count aside: a batch of compiled frames counts its
+    # frames at its end, and a broken engine's state is not to be trusted (it refuses to go on).
+    counts = [{k: v for k, v in sim.counts.items() if k != "frames"} for sim in runs]
+    assert counts[0] == counts[1] and python.max_overlap == numba.max_overlap
+    assert numba._broken is not None  # half-way through a frame, as under Python
+    with pytest.raises(ds.DiscsimError, match="interrupted inside its event loop"):
+        numba.run(frames=1)
 
 
 # --- the choice of backend -------------------------------------------------------------------------------
-def test_auto_takes_numba_when_it_imports_and_the_policy_has_a_compiled_frame(monkeypatch):
+def test_auto_takes_numba_when_it_imports_for_every_policy(monkeypatch):
     discs, box = ds.random_gas(30, 0.3, seed=1)
     expected = "numba" if _numba.available() else "python"
     assert ds.FixedStep(discs, box).backend == expected
-    assert ds.FixedStep(discs, box, policy="bisect").backend == "python"
-    assert ds.FixedStep(discs, box, policy="swept", backend="auto").backend == "python"
+    assert ds.FixedStep(discs, box, policy="bisect").backend == expected
+    assert ds.FixedStep(discs, box, policy="swept", backend="auto").backend == expected
+    assert ds.FixedStep(discs, box, policy="swept", backend="python").backend == "python"
     assert ds.FixedStep(discs, box, backend="python").backend == "python"
     _hide_numba(monkeypatch)
     assert ds.FixedStep(discs, box).backend == "python"
     with pytest.raises(ds.InvalidArgumentError, match=r'backend=.numba. needs numba.*pip install "discsim\[fast\]"'):
         ds.FixedStep(discs, box, backend="numba")
-
-
-@needs_numba
-def test_numba_with_a_sub_frame_policy_says_which_policies_it_compiles():
-    discs, box = ds.random_gas(30, 0.3, seed=1)
-    for policy in ("bisect", "swept"):
-        with pytest.raises(ds.InvalidArgumentError, match=rf"policy '{policy}' has no compiled frame.*'resolve'"):
-            ds.FixedStep(discs, box, policy=policy, backend="numba")
 
 
 @pytest.mark.parametrize("backend", ["fast", None, "Numba", ["numba"]])

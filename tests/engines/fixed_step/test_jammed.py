@@ -17,7 +17,7 @@ import discsim as ds
 @pytest.mark.parametrize("policy", ["resolve", "revert", "separate", "bisect", "swept"])
 def test_a_jammed_start_ends_under_every_policy(name, policy):
     discs, box, _ = JAMS[name]()
-    sim = ds.FixedStep(discs, box, frame_rate=30, policy=policy, backend="python")
+    sim = ds.FixedStep(discs, box, frame_rate=30, policy=policy)  # the backend of this case
     with watchdog(60):
         try:
             sim.run(until=1.0)
@@ -33,4 +33,4 @@ def test_the_hexagonal_lattice_jams_the_sub_frame_policies():
     discs, box, _ = JAMS["hexagonal_lattice"]()
     for policy in ("bisect", "swept"):
         with watchdog(60), pytest.raises(ds.JammedError, match=r"disc \d+ and disc \d+ are jammed"):
-            ds.FixedStep(discs, box, frame_rate=30, policy=policy, backend="python").run(until=1.0)
+            ds.FixedStep(discs, box, frame_rate=30, policy=policy).run(until=1.0)

@@ -69,7 +69,7 @@ def _overlap_test(a, b):
     return overlapping
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
+@pytest.mark.one_backend  # the bisection kernel alone: no frame runs
 @settings(max_examples=300, deadline=None)
 @given(colliding_pair(), st.floats(1e-9, 1e-3))
 def test_bisection_agrees_with_the_analytic_root_to_the_tolerance(p, fraction):
@@ -85,7 +85,7 @@ def test_bisection_agrees_with_the_analytic_root_to_the_tolerance(p, fraction):
     assert found == pytest.approx(t_star, abs=tol + 1e-8 * max(1.0, t_star))
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
+@pytest.mark.one_backend  # the bisection kernel alone: no frame runs
 @pytest.mark.parametrize(("span", "tol", "calls"), [(3.0, 1e-6, 22), (1.0, 0.25, 3), (1.0, 0.3, 2), (0.5, 1.0, 0)])
 def test_bisection_spends_floor_log2_span_over_tol_plus_one_tests(span, tol, calls):
     # Contact at 0.3 * span; floor(log2(span / tol)) + 1 halvings when span >= tol.
@@ -101,7 +101,7 @@ def test_bisection_spends_floor_log2_span_over_tol_plus_one_tests(span, tol, cal
     assert 0.0 <= 0.3 * span - found < tol or (calls == 0 and found == 0.0)
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
+@pytest.mark.one_backend  # the bisection kernel alone: no frame runs
 @pytest.mark.parametrize(
     ("t0", "t1", "tol", "match"),
     [
@@ -121,7 +121,7 @@ def test_bisection_refuses_bad_intervals_and_tolerances_before_testing(t0, t1, t
     assert calls == []
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
+@pytest.mark.one_backend  # the bisection kernel alone: no frame runs
 def test_bisection_stops_at_adjacent_floats():
     # A tolerance below the spacing of floats near t = 1e6 cannot be met: it stops anyway.
     found = time_of_impact_bisect(lambda t: t > 1e6 + 0.5, 1e6, 1e6 + 1.0, 1e-300)
@@ -137,7 +137,6 @@ def _runs(case, policy, **kwargs):
     return pic, pit, ds.compare(pic, pit)
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_swept_catches_the_tunnelling_disc_of_case_1_at_its_frame_rate():
     case = ds.scenarios.missed_collision()
     reports = {policy: _runs(case, policy) for policy in POLICIES}
@@ -154,7 +153,6 @@ def test_swept_catches_the_tunnelling_disc_of_case_1_at_its_frame_rate():
     assert swept.counts["pair_tests"] == 4 and swept.counts["bisection_tests"] == 0
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_bisect_cuts_the_direction_error_of_case_2_to_below_a_thousandth_of_a_degree():
     case = ds.scenarios.wrong_direction()
     _, _, plain = _runs(case, "resolve")
@@ -166,7 +164,6 @@ def test_bisect_cuts_the_direction_error_of_case_2_to_below_a_thousandth_of_a_de
     assert report.max_overlap == 0.0 < plain.max_overlap
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_bisect_finds_the_second_link_of_case_3():
     case = ds.scenarios.multiple_collisions()
     _, _, plain = _runs(case, "resolve")
@@ -180,7 +177,6 @@ def test_bisect_finds_the_second_link_of_case_3():
     assert report.max_direction_error < 1e-3
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_bisect_cuts_the_delay_of_case_4_to_the_tolerance():
     case = ds.scenarios.delay()
     _, _, plain = _runs(case, "resolve")
@@ -190,7 +186,6 @@ def test_bisect_cuts_the_delay_of_case_4_to_the_tolerance():
     assert report.position_error_max < 1e-5
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 @pytest.mark.parametrize("case", ds.study_cases(), ids=lambda case: case.name)
 def test_swept_follows_the_exact_engine_on_all_four_cases(case):
     _, swept, report = _runs(case, "swept")
@@ -202,7 +197,6 @@ def test_swept_follows_the_exact_engine_on_all_four_cases(case):
     assert swept.max_overlap < 1e-12
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 @pytest.mark.parametrize(("fraction", "tests"), [(1e-3, 11), (1e-6, 21), (1e-9, 31)])
 def test_the_bisection_cost_is_counted(fraction, tests):
     # Case 2 has one overlap to bisect: one test where the frame interval starts, then
@@ -217,7 +211,6 @@ def test_the_bisection_cost_is_counted(fraction, tests):
         assert _runs(case, policy)[1].counts["bisection_tests"] == 0
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_newtons_cradle_passes_the_momentum_inside_one_frame_under_bisect_and_swept():
     case = ds.newtons_cradle(5)
     pic = ds.EventDriven(case.discs, case.box).run(until=case.until)
@@ -250,7 +243,6 @@ def test_infinite_mass_discs_never_move_under_sub_frame_policies(policy, periodi
 # --- gases: invariants, broad phases, costs ------------------------------------------------------------------------
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 @settings(max_examples=8, deadline=None)
 @given(seed=st.integers(0, 10_000), policy=st.sampled_from(["bisect", "swept"]), periodic=st.booleans())
 def test_sub_frame_policies_conserve_energy_and_give_the_same_run_with_either_broad_phase(seed, policy, periodic):
@@ -272,7 +264,6 @@ def test_sub_frame_policies_conserve_energy_and_give_the_same_run_with_either_br
     np.testing.assert_allclose(path[-1], grid.positions, atol=1e-12, rtol=0)
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_in_a_gas_swept_finds_every_exact_collision_and_bisect_nearly_all():
     discs, box = ds.random_gas(200, 0.35, periodic=True, seed=3)
     pic = ds.EventDriven(discs, box).run(until=5.0)
@@ -501,7 +492,6 @@ def test_segments_are_validated_like_event_driven():
     assert ds.FixedStep(discs, ds.Box(10.0, 10.0), frame_rate=20.0).bisect_tol == pytest.approx(5e-8)
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_step_returns_the_sub_frame_events_in_time_order():
     discs = ds.Discs([[2.0, 5.0], [8.0, 5.0], [5.0, 6.5]], [[1.0, 0.0], [-1.0, 0.0], [0.0, 2.0]], radii=1.0)
     sim = ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=1.0, policy="swept")
@@ -539,7 +529,6 @@ def test_pit_variants_benchmark_quick_writes_its_table(tmp_path):
     assert "swept" in done.stdout and "bisection" in done.stdout
 
 
-@pytest.mark.one_backend  # no compiled frame: bisection and swept volumes run in Python
 def test_swept_refuses_frames_whose_sweeps_wrap_a_periodic_box():
     discs, box = ds.random_gas(60, 0.45, periodic=True, seed=1, temperature=0.5)
     sim = ds.FixedStep(discs, box, dt=10.0, policy="swept")

@@ -16,7 +16,10 @@ shared machine hits all alike. Figures, as printed and written to ``fixed_step_f
 * ``/ pymunk``: the median over pymunk's (the issue's target for numba: at most 1 at N = 10^2 and 10^3);
 * ``vs python``: python's median over this engine's (the target for numba: at least 5 at N = 10^4).
 
-A second table, ``fixed_step_frames_compile.csv``: seconds to import discsim, build a compiled FixedStep
+A second table, ``fixed_step_sub_frames.csv``: the same, for the sub-frame policies ``bisect`` and ``swept``
+(python against numba, same scenes and dt; ``vs python`` within each policy).
+
+A third table, ``fixed_step_frames_compile.csv``: seconds to import discsim, build a compiled FixedStep
 and do its first frame in a fresh process, with an empty numba cache (``NUMBA_CACHE_DIR`` a new folder: what
 the first run in a fresh environment costs) and then with that cache warm; ``first frame`` is the part the
 first frame takes (compiling, or loading the compiled code), ``process cpu`` the child's CPU seconds.
@@ -39,6 +42,7 @@ import discsim as ds
 
 PACKING_FRACTION = 0.3
 ENGINES = ("python", "numba", "pymunk")
+SUB_FRAME_POLICIES = ("bisect", "swept")
 
 
 @dataclass(frozen=True)
@@ -48,12 +52,18 @@ class Config:
     frames: dict
     repeats: int
     compile_repeats: int
+    sub_frames: dict  # frames timed per run of a sub-frame policy at each N
 
 
 # Every timing lasts 0.1 s or more for the fastest engine: a shorter one may hold a whole time slice of
 # another process on a shared machine.
-FULL = Config(frames={100: 50_000, 1_000: 10_000, 10_000: 1_000}, repeats=5, compile_repeats=3)
-QUICK = Config(frames={60: 200}, repeats=1, compile_repeats=1)
+FULL = Config(
+    frames={100: 50_000, 1_000: 10_000, 10_000: 1_000},
+    repeats=5,
+    compile_repeats=3,
+    sub_frames={100: 20_000, 1_000: 4_000, 10_000: 400},
+)
+QUICK = Config(frames={60: 200}, repeats=1, compile_repeats=1, sub_frames={60: 100})
 
 
 def scene(n: int, seed: int = 0) -> tuple[ds.Discs, ds.Box, float]:
@@ -68,10 +78,10 @@ def scene(n: int, seed: int = 0) -> tuple[ds.Discs, ds.Box, float]:
     return discs, box, step * float(discs.radii.mean()) / speed
 
 
-def measure(n: int, engine: str, frames: int) -> dict:
+def measure(n: int, engine: str, frames: int, policy: str = "resolve") -> dict:
     """Seconds per frame of ``engine`` over ``frames`` frames, after one frame not timed (in this process)."""
     discs, box, dt = scene(n)
-    row = {"n": n, "engine": engine, "frames": frames, "dt": dt}
+    row = {"n": n, "engine": engine, "policy": policy, "frames": frames, "dt": dt}
     if engine == "pymunk":
         import pymunk
         from peers import build_pymunk
@@ -81,11 +91,12 @@ def measure(n: int, engine: str, frames: int) -> dict:
         timing = timed(lambda: run.step(dt, frames))
         row["seconds"], row["cpu_seconds"] = timing.wall / frames, timing.cpu / frames
         return row
-    sim = ds.FixedStep(discs, box, dt=dt, policy="resolve", record=False, backend=engine)
+    sim = ds.FixedStep(discs, box, dt=dt, policy=policy, record=False, backend=engine)
     sim.run(frames=1)
     timing = timed(lambda: sim.run(frames=frames))
     row["seconds"], row["cpu_seconds"] = timing.wall / frames, timing.cpu / frames
     row["list_builds"] = sim.counts["list_builds"]
+    row["detections_per_frame"] = sim.counts["detections"] / (frames + 1)
     row["backend"] = sim.backend
     return row
 
@@ -159,6 +170,66 @@ def frames_section(config: Config, results: Path) -> list[dict]:
     return rows
 
 
+def sub_frames_section(config: Config, results: Path) -> list[dict]:
+    """Time ``bisect`` and ``swept`` under each backend at every N (alternating, fresh processes)."""
+    engines = ["python", "numba"]
+    if ds.FixedStep(*ds.random_gas(4, 0.1, periodic=False, seed=0), policy="swept").backend != "numba":
+        print("note: numba is not installed or is hidden (the fast extra); the python frame alone")
+        engines.remove("numba")
+    rows = []
+    for n, frames in config.sub_frames.items():
+        runs = {(p, e): [] for p in SUB_FRAME_POLICIES for e in engines}
+        for attempt in range(config.repeats):
+            for policy in SUB_FRAME_POLICIES:
+                for engine in engines:
+                    print(
+                        f"  N={n:,} {policy} {engine} run {attempt + 1}/{config.repeats}", file=sys.stderr, flush=True
+                    )
+                    runs[policy, engine].append(measure_fresh(n=n, engine=engine, frames=frames, policy=policy))
+        for policy in SUB_FRAME_POLICIES:
+            for engine in engines:
+                got = runs[policy, engine]
+                seconds = [r["seconds"] for r in got]
+                rows.append(
+                    {
+                        "n": n,
+                        "policy": policy,
+                        "engine": engine,
+                        "frames": frames,
+                        "dt": got[0]["dt"],
+                        "runs": len(seconds),
+                        "us_per_frame": 1e6 * median(seconds),
+                        "us_min": 1e6 * min(seconds),
+                        "us_max": 1e6 * max(seconds),
+                        "cpu_us_per_frame": 1e6 * median([r["cpu_seconds"] for r in got]),
+                        "detections_per_frame": got[0]["detections_per_frame"],
+                    }
+                )
+            python = next(
+                r["us_per_frame"] for r in rows if r["n"] == n and r["policy"] == policy and r["engine"] == "python"
+            )
+            for row in rows:
+                if row["n"] == n and row["policy"] == policy:
+                    row["speedup_vs_python"] = python / row["us_per_frame"]
+    columns = [
+        Column("n", "N", ","),
+        Column("policy", "policy"),
+        Column("engine", "engine"),
+        Column("dt", "dt", ".3g"),
+        Column("frames", "frames", ","),
+        Column("runs", "runs"),
+        Column("us_per_frame", "us/frame", ".1f"),
+        Column("us_min", "min", ".1f"),
+        Column("us_max", "max", ".1f"),
+        Column("cpu_us_per_frame", "cpu us", ".1f"),
+        Column("speedup_vs_python", "vs python", ".1f"),
+        Column("detections_per_frame", "detections/frame", ".2f"),
+    ]
+    print(format_table(rows, columns))
+    write_csv(results / "fixed_step_sub_frames.csv", rows, [c.key for c in columns])
+    return rows
+
+
 _COMPILE_PROBE = """
 import time
 start = time.perf_counter()
@@ -221,10 +292,12 @@ def main(argv=None) -> int:
     args = parse_args(__doc__.splitlines()[0], argv)
     config = QUICK if args.quick else FULL
     if args.repeats is not None:
-        config = Config(config.frames, args.repeats, config.compile_repeats)
+        config = Config(config.frames, args.repeats, config.compile_repeats, config.sub_frames)
     print(f"discsim {ds.__version__} FixedStep frames; {machine_summary()}")
     print(f"\n== One frame, walled gas at packing {PACKING_FRACTION}, policy resolve, same dt ==")
     frames_section(config, args.results)
+    print("\n== One frame of the sub-frame policies, the same gas and dt, python against numba ==")
+    sub_frames_section(config, args.results)
     print("\n== Compile time of the compiled frame ==")
     compile_section(config, args.results)
     return 0

@@ -41,6 +41,11 @@ def test_fixed_step_frames_quick_writes_its_tables(tmp_path):
     assert float(python["speedup_vs_python"]) == 1.0
     if "pymunk" in engines:
         assert all(not math.isnan(float(r["pymunk_ratio"])) for r in rows)
+    sub = _read_csv(tmp_path / "fixed_step_sub_frames.csv")
+    expected = {(p, e) for p in ("bisect", "swept") for e in ["python"] + ["numba"] * _numba.available()}
+    assert {(r["policy"], r["engine"]) for r in sub} == expected
+    assert all(float(r["us_per_frame"]) > 0 and float(r["detections_per_frame"]) >= 0 for r in sub)
+    assert all(float(r["speedup_vs_python"]) == 1.0 for r in sub if r["engine"] == "python")
     if _numba.available():
         compiled = _read_csv(tmp_path / "fixed_step_frames_compile.csv")
         assert [r["cache"] for r in compiled] == ["cold", "warm"]

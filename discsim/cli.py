@@ -537,7 +537,7 @@ def _run_sweep(args) -> int:
                 return 1
             if args.scheduler == "local":
                 cluster = LocalCluster(
-                    n_workers=args.workers or None, threads_per_worker=1, processes=True, dashboard_address=None
+                    n_workers=args.workers or None, threads_per_worker=1, processes=True, dashboard_address=":0"
                 )
                 stack.enter_context(cluster)
                 client = stack.enter_context(Client(cluster))

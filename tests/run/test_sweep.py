@@ -53,7 +53,7 @@ def test_dask_local_cluster_equals_local_pool_and_plain_loop():
     expected = plain_loop(ds.tasks.equation_of_state, EOS_GRID, 2)
     local = ds.sweep(ds.tasks.equation_of_state, EOS_GRID, seeds=2, workers=2)
     with (
-        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster,
         distributed.Client(cluster) as client,
     ):
         remote = ds.sweep(ds.tasks.equation_of_state, EOS_GRID, seeds=2, client=client, progress=True)
@@ -220,7 +220,7 @@ def test_bad_input_is_refused_before_any_task_runs(tmp_path):
 @pytest.mark.slow
 def test_a_closed_dask_client_is_refused(tmp_path):
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster:
         client = distributed.Client(cluster)
         client.close()
         with pytest.raises(ds.InvalidArgumentError, match="the dask client is closed"):

@@ -3,19 +3,17 @@
 No test here asserts a speed: timings belong to the scripts' output, not to pass/fail.
 """
 
-import csv
 import doctest
 import importlib.util
 import inspect
 import math
-import os
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from benchscripts import read_csv, run_quick
 from paths import BENCHMARKS
 
 import discsim as ds
@@ -33,23 +31,6 @@ benchutils = _load("benchutils", BENCHMARKS / "benchutils.py")
 
 
 # --- the scripts run -------------------------------------------------------------------
-def _run_quick(script: str, results: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, MPLBACKEND="Agg")
-    return subprocess.run(
-        [sys.executable, str(BENCHMARKS / script), "--quick", "--results", str(results)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=600,
-        check=False,
-    )
-
-
-def _read_csv(path: Path) -> list[dict]:
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
-
-
 @pytest.fixture(scope="module")
 def throughput():
     """benchmarks/throughput.py as a module (it imports ``benchutils`` from its own folder)."""
@@ -72,17 +53,17 @@ _TARGET_KEYS = [
 
 @pytest.mark.slow
 def test_throughput_quick_writes_its_csv_and_plot(tmp_path):
-    done = _run_quick("throughput.py", tmp_path)
+    done = run_quick("throughput.py", tmp_path)
     assert done.returncode == 0, done.stderr
     default_queue = inspect.signature(ds.EventDriven).parameters["queue"].default
-    rows = _read_csv(tmp_path / "throughput.csv")
+    rows = read_csv(tmp_path / "throughput.csv")
     assert len(rows) == 4  # 2 sizes x 2 packing fractions
     for row in rows:
         assert row["queue"] == default_queue  # the main section times the engine's default queue
         assert float(row["collisions_per_s"]) > 0
         assert 0 < int(row["max_queue"]) <= int(row["n"])  # one pending event per disc at most
         assert float(row["peak_mb"]) > 0
-    queues = _read_csv(tmp_path / "throughput_queue.csv")
+    queues = read_csv(tmp_path / "throughput_queue.csv")
     assert [r["queue"] for r in queues] == ["calendar", "sorted", "heap"]  # N = 400 only
     for row in queues:
         n = int(row["n"])
@@ -95,7 +76,7 @@ def test_throughput_quick_writes_its_csv_and_plot(tmp_path):
     assert int(by_queue["sorted"]["storage"]) <= int(by_queue["sorted"]["n"])  # no dead entries
     assert len({r["timed_collisions"] for r in queues}) == 1
     # The targets need N = 10^3..10^5, which quick mode does not run: every row says so.
-    targets = _read_csv(tmp_path / "throughput_targets.csv")
+    targets = read_csv(tmp_path / "throughput_targets.csv")
     assert [r["target"] for r in targets] == _TARGET_KEYS
     assert [(r["comparison"], float(r["limit"])) for r in targets] == [
         (">=", 40_000.0),
@@ -108,25 +89,25 @@ def test_throughput_quick_writes_its_csv_and_plot(tmp_path):
     assert (tmp_path / "throughput.png").stat().st_size > 0
     assert "coll/s" in done.stdout and "vs sorted" in done.stdout and "storage" in done.stdout
     assert "targets of the engine issue" in done.stdout and "not measured" in done.stdout
-    pit = _read_csv(tmp_path / "throughput_pit.csv")
+    pit = read_csv(tmp_path / "throughput_pit.csv")
     assert {r["broad_phase"] for r in pit} == {"grid", "all-pairs"}
     assert all(float(r["frames_per_s"]) > 0 and float(r["pair_tests_per_s"]) > 0 for r in pit)
-    costs = _read_csv(tmp_path / "throughput_crossover.csv")
+    costs = read_csv(tmp_path / "throughput_crossover.csv")
     assert costs and all(float(r["pic_s_per_time"]) > 0 and float(r["pit_s_per_time"]) > 0 for r in costs)
     assert (tmp_path / "throughput_pit.png").stat().st_size > 0
 
 
 @pytest.mark.slow
 def test_peers_quick_writes_its_csv_and_plot(tmp_path):
-    done = _run_quick("peers.py", tmp_path)
+    done = run_quick("peers.py", tmp_path)
     assert done.returncode == 0, done.stderr
-    rows = _read_csv(tmp_path / "peers.csv")
+    rows = read_csv(tmp_path / "peers.csv")
     engines = {r["engine"] for r in rows}
     assert {"discsim", "naive", "billiards"} <= engines  # billiards appears even when skipped
     ran = [r for r in rows if r["engine"] in ("discsim", "naive") and r["status"] == "ok"]
     assert len(ran) == 4  # 2 sizes x 2 engines
     assert (tmp_path / "peers.png").stat().st_size > 0
-    pit = _read_csv(tmp_path / "peers_pit.csv")
+    pit = read_csv(tmp_path / "peers_pit.csv")
     fixed = [r for r in pit if r["engine"] == "fixed_step"]
     assert fixed and float(fixed[0]["seconds_per_frame"]) > 0
     assert int(fixed[0]["matched"]) + int(fixed[0]["missed"]) == int(fixed[0]["truth"])
@@ -274,14 +255,14 @@ def test_format_table_docstring_example():
 @pytest.mark.slow
 @pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
 def test_backends_script_writes_both_backends_side_by_side(tmp_path):
-    done = _run_quick("backends.py", tmp_path)
+    done = run_quick("backends.py", tmp_path)
     assert done.returncode == 0, done.stderr
-    rows = _read_csv(tmp_path / "backends.csv")
+    rows = read_csv(tmp_path / "backends.csv")
     assert {row["discs"] for row in rows} == {"monodisperse", "1:10 mixture"}
     for row in rows:
         assert float(row["python_rate"]) > 0 and float(row["numba_rate"]) > 0
         assert float(row["speedup"]) == pytest.approx(float(row["numba_rate"]) / float(row["python_rate"]))
-    compile_rows = _read_csv(tmp_path / "backends_compile.csv")
+    compile_rows = read_csv(tmp_path / "backends_compile.csv")
     assert {(row["cache"], row["scipy"]) for row in compile_rows} == {
         ("cold", "visible"),
         ("warm", "visible"),

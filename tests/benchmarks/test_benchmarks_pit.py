@@ -4,32 +4,12 @@ Each script runs once in a subprocess into a temporary folder; the tests read
 its CSV files. No test asserts a speed: timings belong to the scripts' output.
 """
 
-import csv
 import math
-import os
-import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from benchscripts import read_csv, run_quick
 from paths import BENCHMARKS
-
-
-def _run_quick(script: str, results: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, MPLBACKEND="Agg")
-    return subprocess.run(
-        [sys.executable, str(BENCHMARKS / script), "--quick", "--results", str(results)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=600,
-        check=False,
-    )
-
-
-def _read_csv(path: Path) -> list[dict]:
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
 
 
 def _number(text: str) -> float:
@@ -40,7 +20,7 @@ def _number(text: str) -> float:
 @pytest.fixture(scope="module")
 def event_counts(tmp_path_factory):
     results = tmp_path_factory.mktemp("event_counts")
-    done = _run_quick("event_counts.py", results)
+    done = run_quick("event_counts.py", results)
     return done, results
 
 
@@ -50,7 +30,7 @@ def test_event_counts_quick_runs_and_writes_its_files(event_counts):
     assert done.returncode == 0, done.stderr
     assert (results / "event_counts.png").stat().st_size > 0
     assert "missed %" in done.stdout and "work units" in done.stdout
-    rows = _read_csv(results / "event_counts.csv")
+    rows = read_csv(results / "event_counts.csv")
     expected = {
         "scenario",
         "method",
@@ -87,7 +67,7 @@ def test_event_counts_quick_runs_and_writes_its_files(event_counts):
 def test_event_counts_pic_is_the_reference(event_counts):
     done, results = event_counts
     assert done.returncode == 0, done.stderr
-    rows = _read_csv(results / "event_counts.csv")
+    rows = read_csv(results / "event_counts.csv")
     pic = [r for r in rows if r["method"] == "PIC"]
     assert len(pic) == len({r["scenario"] for r in rows})
     for row in pic:
@@ -104,7 +84,7 @@ def test_event_counts_pic_is_the_reference(event_counts):
 def test_event_counts_pit_work_grows_with_the_frame_rate_and_buys_accuracy(event_counts):
     done, results = event_counts
     assert done.returncode == 0, done.stderr
-    rows = _read_csv(results / "event_counts.csv")
+    rows = read_csv(results / "event_counts.csv")
     for scenario in {r["scenario"] for r in rows}:
         pit = [r for r in rows if r["scenario"] == scenario and r["policy"] == "resolve"]
         pit.sort(key=lambda r: _number(r["fps"]))
@@ -124,7 +104,7 @@ def test_event_counts_pit_work_grows_with_the_frame_rate_and_buys_accuracy(event
 @pytest.fixture(scope="module")
 def accuracy_map(tmp_path_factory):
     results = tmp_path_factory.mktemp("accuracy_map")
-    done = _run_quick("accuracy_map.py", results)
+    done = run_quick("accuracy_map.py", results)
     return done, results
 
 
@@ -134,7 +114,7 @@ def test_accuracy_map_quick_runs_and_writes_its_files(accuracy_map):
     assert done.returncode == 0, done.stderr
     assert (results / "accuracy_map.png").stat().st_size > 0
     assert "boundary" in done.stdout
-    rows = _read_csv(results / "accuracy_map.csv")
+    rows = read_csv(results / "accuracy_map.csv")
     expected = {
         "policy",
         "packing_fraction",
@@ -152,7 +132,7 @@ def test_accuracy_map_quick_runs_and_writes_its_files(accuracy_map):
     steps = {r["step"] for r in rows}
     fractions = {r["packing_fraction"] for r in rows}
     assert len(rows) == len(policies) * len(steps) * len(fractions)  # a full grid
-    boundary = _read_csv(results / "accuracy_map_boundary.csv")
+    boundary = read_csv(results / "accuracy_map_boundary.csv")
     assert len(boundary) == len(policies) * len(fractions)
 
 
@@ -160,7 +140,7 @@ def test_accuracy_map_quick_runs_and_writes_its_files(accuracy_map):
 def test_accuracy_map_errors_grow_with_the_step(accuracy_map):
     done, results = accuracy_map
     assert done.returncode == 0, done.stderr
-    rows = [r for r in _read_csv(results / "accuracy_map.csv") if r["status"] == "ok"]
+    rows = [r for r in read_csv(results / "accuracy_map.csv") if r["status"] == "ok"]
     for row in rows:
         assert int(row["truth_collisions"]) > 0
         assert 0.0 <= _number(row["missed_fraction"]) <= 1.0
@@ -182,8 +162,8 @@ def test_accuracy_map_errors_grow_with_the_step(accuracy_map):
 def test_accuracy_map_boundary_is_consistent_with_the_cells(accuracy_map):
     done, results = accuracy_map
     assert done.returncode == 0, done.stderr
-    rows = _read_csv(results / "accuracy_map.csv")
-    for limit in _read_csv(results / "accuracy_map_boundary.csv"):
+    rows = read_csv(results / "accuracy_map.csv")
+    for limit in read_csv(results / "accuracy_map_boundary.csv"):
         cells = [
             r for r in rows if r["policy"] == limit["policy"] and r["packing_fraction"] == limit["packing_fraction"]
         ]
@@ -204,7 +184,7 @@ def test_accuracy_map_rerun_reads_its_cache(accuracy_map):
     assert done.returncode == 0, done.stderr
     assert "sweep of 40 tasks" in done.stdout and "40 ran" in done.stdout
     before = {name: (results / name).read_text() for name in ("accuracy_map.csv", "accuracy_map_boundary.csv")}
-    again = _run_quick("accuracy_map.py", results)
+    again = run_quick("accuracy_map.py", results)
     assert again.returncode == 0, again.stderr
     assert "0 ran (0 s in them), 40 from the cache, 0 failed" in again.stdout
     for name, text in before.items():

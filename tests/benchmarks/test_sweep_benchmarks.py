@@ -5,43 +5,22 @@ numbers must satisfy (never a speed): the pooled Z against Henderson's equation 
 that combine the seeds, a rerun served from the cache, the same table from every sweep configuration.
 """
 
-import csv
 import math
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
+from benchscripts import read_csv, run_quick
 from paths import BENCHMARKS
 
 import discsim as ds
-
-
-def _run_quick(script: str, results: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, MPLBACKEND="Agg")
-    return subprocess.run(
-        [sys.executable, str(BENCHMARKS / script), "--quick", "--results", str(results)],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=600,
-        check=False,
-    )
-
-
-def _read_csv(path: Path) -> list[dict]:
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
 
 
 # --- equation_of_state.py -------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def equation_of_state(tmp_path_factory):
     results = tmp_path_factory.mktemp("equation_of_state")
-    first = _run_quick("equation_of_state.py", results)
+    first = run_quick("equation_of_state.py", results)
     csv_first = (results / "equation_of_state.csv").read_text() if first.returncode == 0 else ""
-    second = _run_quick("equation_of_state.py", results)
+    second = run_quick("equation_of_state.py", results)
     return first, second, results, csv_first
 
 
@@ -49,7 +28,7 @@ def test_equation_of_state_quick_writes_its_csv_and_figure(equation_of_state):
     first, _, results, _ = equation_of_state
     assert first.returncode == 0, first.stderr
     assert (results / "equation_of_state.png").stat().st_size > 10_000
-    rows = _read_csv(results / "equation_of_state.csv")
+    rows = read_csv(results / "equation_of_state.csv")
     assert [float(r["packing_fraction"]) for r in rows] == [0.1, 0.4, 0.7]
     for row in rows:
         eta, z, err = float(row["packing_fraction"]), float(row["z"]), float(row["z_err"])
@@ -84,10 +63,10 @@ def test_equation_of_state_rerun_reads_the_cache(equation_of_state):
 @pytest.mark.slow
 def test_sweep_quick_times_every_configuration(tmp_path):
     pytest.importorskip("distributed")
-    done = _run_quick("sweep.py", tmp_path)
+    done = run_quick("sweep.py", tmp_path)
     assert done.returncode == 0, done.stderr
     assert "Every configuration gave the same table" in done.stdout
-    rows = _read_csv(tmp_path / "sweep.csv")
+    rows = read_csv(tmp_path / "sweep.csv")
     assert [(r["path"], int(r["workers"])) for r in rows] == [("local", 1), ("local", 2), ("dask", 1), ("dask", 2)]
     for row in rows:
         assert int(row["tasks"]) == 6  # 3 packing fractions x 2 seeds
@@ -95,7 +74,7 @@ def test_sweep_quick_times_every_configuration(tmp_path):
         assert (row["path"] == "dask") == math.isfinite(float(row["cluster_start_s"]))
         if row["workers"] == "1":
             assert float(row["speedup"]) == 1.0
-    overhead = _read_csv(tmp_path / "sweep_overhead.csv")
+    overhead = read_csv(tmp_path / "sweep_overhead.csv")
     assert [(r["path"], int(r["workers"])) for r in overhead] == [("in-process", 0), ("local", 2), ("dask", 2)]
     assert float(overhead[0]["overhead_per_task_ms"]) == 0.0
     for row in overhead:

@@ -34,7 +34,7 @@ import time
 import traceback
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -62,7 +62,6 @@ class _Job:
     error: str | None = None
     traceback: str | None = None
     seconds: float = 0.0
-    history: list = field(default_factory=list)
 
 
 # --- what the user gave ----------------------------------------------------------------------------------
@@ -292,22 +291,53 @@ class _InProcess:
 
     label = "this process"
 
-    def submit(self, *args):
-        return _Deferred(args)
+    def __init__(self):
+        self._pending = []
 
-    def wait_any(self, futures):
-        first = futures[0]
-        first.result()
-        return [first]
+    def submit(self, *args):
+        task = _Deferred(args)
+        self._pending.append(task)
+        return task
+
+    def next_done(self):
+        task = self._pending.pop(0)
+        task.result()
+        return task
 
     def close(self, cancel: bool = False) -> None:
-        pass
+        self._pending.clear()
 
 
-class _LocalPool:
+class _Finished:
+    """Futures as they finish, in O(1) each: every future puts itself in a queue when done.
+
+    (Waiting on all unfinished futures after each completion would cost O(tasks) each time.)
+    """
+
+    def __init__(self):
+        import queue
+
+        self._done = queue.SimpleQueue()
+
+    def track(self, future):
+        future.add_done_callback(self._done.put)
+        return future
+
+    def next_done(self):
+        import queue
+
+        while True:  # a timeout, so that Ctrl-C is seen while waiting
+            try:
+                return self._done.get(timeout=0.2)
+            except queue.Empty:
+                continue
+
+
+class _LocalPool(_Finished):
     """A process pool on this machine (``fork`` on Linux, so tasks defined in a notebook or script run)."""
 
     def __init__(self, workers: int):
+        super().__init__()
         self.workers = workers
         self.label = f"{workers} local process{'es' if workers > 1 else ''}"
         self._pool = None
@@ -325,16 +355,11 @@ class _LocalPool:
         from concurrent.futures.process import BrokenProcessPool
 
         try:
-            return self._executor().submit(attempt, *args)
+            return self.track(self._executor().submit(attempt, *args))
         except BrokenProcessPool:  # a worker died: a new pool for what is left
             self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
-            return self._executor().submit(attempt, *args)
-
-    def wait_any(self, futures):
-        from concurrent.futures import FIRST_COMPLETED, wait
-
-        return wait(futures, return_when=FIRST_COMPLETED).done
+            return self.track(self._executor().submit(attempt, *args))
 
     def close(self, cancel: bool = False) -> None:
         if self._pool is not None:
@@ -342,24 +367,25 @@ class _LocalPool:
             self._pool = None
 
 
-class _Dask:
+class _Dask(_Finished):
     """A ``dask.distributed.Client``: the tasks go to its cluster; nothing is started or closed here."""
 
     def __init__(self, client):
+        super().__init__()
         self.client = client
+        self._futures = []
         workers = len(client.scheduler_info().get("workers", {}))
         self.label = f"dask at {client.scheduler.address} ({workers} worker{'s' if workers != 1 else ''})"
 
     def submit(self, *args):
-        return self.client.submit(attempt, *args, pure=False)
-
-    def wait_any(self, futures):
-        from distributed import wait
-
-        return wait(list(futures), return_when="FIRST_COMPLETED").done
+        future = self.client.submit(attempt, *args, pure=False)
+        self._futures.append(future)
+        return self.track(future)
 
     def close(self, cancel: bool = False) -> None:
-        pass
+        if cancel and self._futures:
+            self.client.cancel(self._futures)
+        self._futures.clear()
 
 
 def _executor(client, workers):
@@ -423,7 +449,9 @@ def sweep(
         workers: processes of the local pool (default: this machine's cores); 0 runs the tasks in this
             process, one after another (for debugging). Not with ``client``.
         cache: a folder for finished tasks' results (see :mod:`discsim.run.cache`): nothing finished is
-            run twice, and a killed sweep resumes where it stopped. None: no cache.
+            run twice, and a killed sweep resumes where it stopped. None: no cache. The key holds the
+            task's name and discsim's version, not their code: after changing the task (or discsim
+            without a new version), give the sweep a new folder, or its old results are served.
         retries: more attempts for a task that raised (or whose worker died) before it counts as failed.
         progress: show a bar over the tasks (tqdm when installed).
 
@@ -432,7 +460,9 @@ def sweep(
         ``seed``, the task's results, and ``error`` (None, or the error of a task that failed every
         attempt). ``table.attrs["failures"]`` lists the failed tasks (``params``, ``seed``, ``error``,
         ``traceback``, ``attempts``); ``table.attrs["sweep"]`` counts the tasks (``tasks``, ``ran``,
-        ``cached``, ``failed``, ``retries``) and gives the wall-clock ``seconds`` and where they ran.
+        ``cached``, ``failed``, ``retries``) and gives the wall-clock ``seconds`` and where they ran;
+        ``table.attrs["seconds"]`` holds each row's task time (of its last attempt; as stored for a row
+        from the cache). Times stay out of the table, so that the table repeats bit for bit.
         A sweep with failures also warns (``RuntimeWarning``).
 
     Raises:
@@ -520,25 +550,24 @@ def _run(pd, task, name, jobs, executor, store, retries, progress):
         for job in todo:
             inflight[executor.submit(task, job.params, job.seed)] = job
         while inflight:
-            for future in executor.wait_any(list(inflight)):
-                job = inflight.pop(future)
-                outcome = _outcome(future)
-                job.attempts += 1
-                if outcome[0] == "ok":
-                    job.result, job.seconds = outcome[1], outcome[2]
-                    job.error = job.traceback = None
-                    if store is not None:
-                        store.put(job.params, job.seed, job.result, job.seconds, job.attempts)
-                else:
-                    job.error, job.traceback = outcome[1], outcome[2]
-                    job.history.append(outcome[1])
-                    if job.attempts <= retries:
-                        resubmitted += 1
-                        inflight[executor.submit(task, job.params, job.seed)] = job
-                        continue
-                finished += 1
-                if meter is not None:
-                    meter.update(1, finished)
+            future = executor.next_done()
+            job = inflight.pop(future)
+            outcome = _outcome(future)
+            job.attempts += 1
+            if outcome[0] == "ok":
+                job.result, job.seconds = outcome[1], outcome[2]
+                job.error = job.traceback = None
+                if store is not None:
+                    store.put(job.params, job.seed, job.result, job.seconds, job.attempts)
+            else:
+                job.error, job.traceback, job.seconds = outcome[1], outcome[2], outcome[3]
+                if job.attempts <= retries:
+                    resubmitted += 1
+                    inflight[executor.submit(task, job.params, job.seed)] = job
+                    continue
+            finished += 1
+            if meter is not None:
+                meter.update(1, finished)
     except KeyboardInterrupt:
         executor.close(cancel=True)
         if bar is not None:
@@ -580,6 +609,7 @@ def _table(pd, name, jobs, executor, store, resubmitted, seconds, retries):
         }
         for job in failed
     ]
+    table.attrs["seconds"] = [float(job.seconds) for job in jobs]
     table.attrs["sweep"] = {
         "task": name,
         "tasks": len(jobs),

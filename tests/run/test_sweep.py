@@ -134,6 +134,7 @@ def test_a_failing_point_is_reported_with_its_traceback_and_the_others_finish():
     assert failure["params"] == {"a": 2} and failure["attempts"] == 3
     assert "raise ValueError(msg)" in failure["traceback"] and "fails_at" in failure["traceback"]
     assert table.attrs["sweep"]["retries"] == 2 and table.attrs["sweep"]["failed"] == 1
+    assert len(table.attrs["seconds"]) == 4 and all(s >= 0.0 for s in table.attrs["seconds"])
 
 
 def test_retries_rescue_a_flaky_task_and_are_counted(tmp_path):
@@ -159,6 +160,12 @@ def test_a_worker_that_dies_fails_its_tasks_and_the_pool_is_restarted():
     failed = table[table.error.notna()]
     assert 1 in failed.a.tolist() and "worker running the task was lost" in failed.error.iloc[0]
     assert table[table.error.isna()].a2.tolist() == [a * a for a in table[table.error.isna()].a]
+
+
+def test_many_tasks_on_the_pool_each_reported_once():
+    table = ds.sweep(sweep_tasks.draw, {"a": list(range(300))}, workers=2)
+    assert table.a.tolist() == list(range(300)) and table.attrs["sweep"]["ran"] == 300
+    assert table["sum"].tolist() == [sweep_tasks.draw(a, seed=table.seed[0])["sum"] for a in range(300)]
 
 
 def test_a_task_that_returns_no_dict_fails_with_a_message():

@@ -224,6 +224,13 @@ def test_bad_input_is_refused_before_any_task_runs(tmp_path):
     assert [p.name for p in (tmp_path / "foreign").iterdir()] == ["notes.txt"]
 
 
+def test_without_pandas_the_sweep_names_the_extra(monkeypatch, tmp_path):
+    monkeypatch.setitem(sys.modules, "pandas", None)  # as if it were not installed
+    with pytest.raises(ds.InvalidArgumentError, match=r'pip install "discsim\[sweep\]"'):
+        ds.sweep(sweep_tasks.logged, {"a": [1], "log": str(tmp_path / "ran.txt")}, workers=0)
+    assert not (tmp_path / "ran.txt").exists()
+
+
 @pytest.mark.slow
 def test_a_closed_dask_client_is_refused(tmp_path):
     distributed = pytest.importorskip("distributed")

@@ -10,7 +10,7 @@ from paths import PACKAGE
 
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
-    "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt", "_numba"],
+    "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled"],
     "model": ["scene", "scenarios", "events", "trajectory", "cells", "repair"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "view", "__init__", "__main__"],

@@ -24,19 +24,7 @@ import math
 
 import numpy as np
 
-from discsim import kernels
-from discsim._numba import numba
-
-_nb = numba()
-if _nb is None:  # importable without numba (doctest collection); the backend only runs when numba imports
-
-    def jit(function):
-        return function
-
-else:
-    # error_model="numpy": a division by zero gives inf or nan instead of a check on every division; the
-    # loop divides only by numbers it has tested, as the Python backend does.
-    jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+from discsim._compiled import jit, prefetch, reflect_off_segment, segment_time_of_impact
 
 INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT = 0, 1, 2, 3
@@ -168,49 +156,6 @@ def heapify(heap, ht, hpos, ints):
         hpos[heap[k]] = k
     for k in range((size >> 1) - 1, -1, -1):
         _sift_down(k, size, heap, ht, hpos)
-
-
-# --- geometry ------------------------------------------------------------------------------------------
-# The kernel itself, compiled: one definition of the time of impact (its callers below are compiled too).
-time_of_impact = jit(kernels.time_of_impact)
-
-
-@jit
-def segment_time_of_impact(px, py, vx, vy, radius, ax, ay, bx, by):
-    """As :func:`discsim.kernels.segment_time_of_impact`."""
-    ex, ey = bx - ax, by - ay
-    length2 = ex * ex + ey * ey
-    best = INF
-    length = math.sqrt(length2)
-    nx, ny = -ey / length, ex / length
-    s = (px - ax) * nx + (py - ay) * ny
-    vn = vx * nx + vy * ny
-    if s < 0.0:
-        s, vn = -s, -vn
-    if vn < 0.0:
-        t = (s - radius) / -vn if s > radius else 0.0
-        u = ((px + vx * t - ax) * ex + (py + vy * t - ay) * ey) / length2
-        if 0.0 <= u <= 1.0:
-            best = t
-    t = time_of_impact(ax - px, ay - py, -vx, -vy, radius)
-    if t < best:
-        best = t
-    t = time_of_impact(bx - px, by - py, -vx, -vy, radius)
-    if t < best:
-        best = t
-    return best
-
-
-@jit
-def reflect_off_segment(px, py, vx, vy, ax, ay, bx, by):
-    """As :func:`discsim.kernels.reflect_off_segment`."""
-    ex, ey = bx - ax, by - ay
-    u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
-    u = min(max(u, 0.0), 1.0)
-    qx, qy = ax + u * ex, ay + u * ey
-    nx, ny = px - qx, py - qy
-    k = 2.0 * (vx * nx + vy * ny) / (nx * nx + ny * ny)
-    return vx - k * nx, vy - k * ny
 
 
 # --- prediction ----------------------------------------------------------------------------------------
@@ -484,6 +429,33 @@ def _enter(i, c, head, nxt):
     nxt[j] = i
 
 
+@jit
+def _prefetch_disc(c, rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs):
+    """Ask for every record of disc ``c`` that an event of it reads (see :func:`discsim._compiled.prefetch`)."""
+    prefetch(rec, c * 8)
+    prefetch(count, c)
+    prefetch(kept_partner, c)
+    prefetch(kept_stamp, c)
+    prefetch(cell, c)
+    prefetch(hpos, c)
+    prefetch(qk, c)
+    prefetch(qo, c)
+    prefetch(qs, c)
+
+
+@jit
+def _prefetch_cells(c, head, nx, ny):
+    """Start fetching the heads of the 3 x 3 cells around cell ``c`` (three runs of three in memory)."""
+    cx = c // ny
+    for ddx in range(-1, 2):
+        ox = cx + ddx
+        if ox < 0:
+            ox += nx
+        elif ox >= nx:
+            ox -= nx
+        prefetch(head, ox * ny + c - cx * ny)
+
+
 # --- the hot loop --------------------------------------------------------------------------------------
 @jit
 def rebase(shift, rec, heap, ht, hpos, ints, floats):
@@ -542,6 +514,14 @@ def run_events(
         if t > horizon:
             break
         pops += 1
+        # At large N every record below waits for memory, and the next disc is known only when the queue
+        # pops it: ask now for the records of this event's partner and its cells, and of the two events
+        # most likely next (the heap's second and third), so that the fetches overlap (no effect on results).
+        for k in range(1, min(3, ints[I_SIZE])):
+            _prefetch_disc(heap[k], rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
+        if qk[i] == COLLISION:
+            _prefetch_disc(qo[i], rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
+        _prefetch_cells(cell[i], head, nx, ny)
         # The event stays at the top of the heap: predicting i again, as every branch below does,
         # replaces it (see push).
         kind = qk[i]
@@ -593,6 +573,7 @@ def run_events(
             uyj = vyj - f2 * k * dy
             rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, uxi, uyi, t
             rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], rec[j, T] = xj, yj, uxj, uyj, t
+            _prefetch_cells(cell[j], head, nx, ny)
             virial -= mi * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
             count[i] += 1
             n_coll += 1

@@ -31,6 +31,8 @@ import math
 import numpy as np
 
 from discsim import kernels
+from discsim._compiled import segment_time_of_impact as _segment_time_of_impact
+from discsim._compiled import time_of_impact as _time_of_impact
 from discsim._numba import numba
 from discsim.engines.fixed_step.numba.kernels import (
     _cells,
@@ -71,7 +73,6 @@ DONE, JAMMED = 0, 1
 MAX_RESPONSES = 1000
 MAX_RESPONSES_PER_DISC = 50
 
-_time_of_impact = leaf(kernels.time_of_impact)
 _wall_time = leaf(kernels.wall_time)
 
 
@@ -82,32 +83,6 @@ def _round_image(d, size):
     if abs(d) <= 0.5 * size:
         return d
     return d - size * np.rint(d / size)
-
-
-@leaf
-def _segment_time_of_impact(px, py, vx, vy, radius, ax, ay, bx, by):
-    """:func:`discsim.kernels.segment_time_of_impact`."""
-    ex, ey = bx - ax, by - ay
-    length2 = ex * ex + ey * ey
-    best = INF
-    length = math.sqrt(length2)
-    nx, ny = -ey / length, ex / length
-    s = (px - ax) * nx + (py - ay) * ny
-    vn = vx * nx + vy * ny
-    if s < 0.0:
-        s, vn = -s, -vn
-    if vn < 0.0:
-        t = (s - radius) / -vn if s > radius else 0.0
-        u = ((px + vx * t - ax) * ex + (py + vy * t - ay) * ey) / length2
-        if 0.0 <= u <= 1.0:
-            best = t
-    t = _time_of_impact(ax - px, ay - py, -vx, -vy, radius)
-    if t < best:
-        best = t
-    t = _time_of_impact(bx - px, by - py, -vx, -vy, radius)
-    if t < best:
-        best = t
-    return best
 
 
 @leaf

@@ -114,6 +114,33 @@ def _pymunk_missing() -> str:
     return ""
 
 
+#: The columns every timing table shares (after the labels of its configuration).
+_TIMING_COLUMNS = [
+    Column("dt", "dt", ".3g"),
+    Column("frames", "frames", ","),
+    Column("runs", "runs"),
+    Column("us_per_frame", "us/frame", ".1f"),
+    Column("us_min", "min", ".1f"),
+    Column("us_max", "max", ".1f"),
+    Column("cpu_us_per_frame", "cpu us", ".1f"),
+]
+
+
+def _timing_row(got: list[dict], **labels) -> dict:
+    """A table row from the runs ``got`` of one configuration: its ``labels``, then microseconds per frame
+    (median, min, max, CPU median) and the frame's ``dt``."""
+    seconds = [r["seconds"] for r in got]
+    return {
+        **labels,
+        "dt": got[0]["dt"],
+        "runs": len(seconds),
+        "us_per_frame": 1e6 * median(seconds),
+        "us_min": 1e6 * min(seconds),
+        "us_max": 1e6 * max(seconds),
+        "cpu_us_per_frame": 1e6 * median([r["cpu_seconds"] for r in got]),
+    }
+
+
 def frames_section(config: Config, results: Path) -> list[dict]:
     """Time every engine at every N (alternating, fresh processes); print and write the table."""
     missing = _pymunk_missing()
@@ -131,21 +158,9 @@ def frames_section(config: Config, results: Path) -> list[dict]:
                 print(f"  N={n:,} {engine} run {attempt + 1}/{config.repeats}", file=sys.stderr, flush=True)
                 runs[engine].append(measure_fresh(n=n, engine=engine, frames=frames))
         for engine in engines:
-            seconds = [r["seconds"] for r in runs[engine]]
-            rows.append(
-                {
-                    "n": n,
-                    "engine": engine,
-                    "frames": frames,
-                    "dt": runs[engine][0]["dt"],
-                    "runs": len(seconds),
-                    "us_per_frame": 1e6 * median(seconds),
-                    "us_min": 1e6 * min(seconds),
-                    "us_max": 1e6 * max(seconds),
-                    "cpu_us_per_frame": 1e6 * median([r["cpu_seconds"] for r in runs[engine]]),
-                    "list_builds": runs[engine][0].get("list_builds", math.nan),
-                }
-            )
+            got = runs[engine]
+            rows.append(_timing_row(got, n=n, engine=engine, frames=frames))
+            rows[-1]["list_builds"] = got[0].get("list_builds", math.nan)
         by = {r["engine"]: r["us_per_frame"] for r in rows if r["n"] == n}
         for row in rows:
             if row["n"] == n:
@@ -154,13 +169,7 @@ def frames_section(config: Config, results: Path) -> list[dict]:
     columns = [
         Column("n", "N", ","),
         Column("engine", "engine"),
-        Column("dt", "dt", ".3g"),
-        Column("frames", "frames", ","),
-        Column("runs", "runs"),
-        Column("us_per_frame", "us/frame", ".1f"),
-        Column("us_min", "min", ".1f"),
-        Column("us_max", "max", ".1f"),
-        Column("cpu_us_per_frame", "cpu us", ".1f"),
+        *_TIMING_COLUMNS,
         Column("pymunk_ratio", "/ pymunk", ".2f"),
         Column("speedup_vs_python", "vs python", ".1f"),
         Column("list_builds", "list builds", ".0f"),
@@ -189,22 +198,8 @@ def sub_frames_section(config: Config, results: Path) -> list[dict]:
         for policy in SUB_FRAME_POLICIES:
             for engine in engines:
                 got = runs[policy, engine]
-                seconds = [r["seconds"] for r in got]
-                rows.append(
-                    {
-                        "n": n,
-                        "policy": policy,
-                        "engine": engine,
-                        "frames": frames,
-                        "dt": got[0]["dt"],
-                        "runs": len(seconds),
-                        "us_per_frame": 1e6 * median(seconds),
-                        "us_min": 1e6 * min(seconds),
-                        "us_max": 1e6 * max(seconds),
-                        "cpu_us_per_frame": 1e6 * median([r["cpu_seconds"] for r in got]),
-                        "detections_per_frame": got[0]["detections_per_frame"],
-                    }
-                )
+                rows.append(_timing_row(got, n=n, policy=policy, engine=engine, frames=frames))
+                rows[-1]["detections_per_frame"] = got[0]["detections_per_frame"]
             python = next(
                 r["us_per_frame"] for r in rows if r["n"] == n and r["policy"] == policy and r["engine"] == "python"
             )
@@ -215,13 +210,7 @@ def sub_frames_section(config: Config, results: Path) -> list[dict]:
         Column("n", "N", ","),
         Column("policy", "policy"),
         Column("engine", "engine"),
-        Column("dt", "dt", ".3g"),
-        Column("frames", "frames", ","),
-        Column("runs", "runs"),
-        Column("us_per_frame", "us/frame", ".1f"),
-        Column("us_min", "min", ".1f"),
-        Column("us_max", "max", ".1f"),
-        Column("cpu_us_per_frame", "cpu us", ".1f"),
+        *_TIMING_COLUMNS,
         Column("speedup_vs_python", "vs python", ".1f"),
         Column("detections_per_frame", "detections/frame", ".2f"),
     ]

@@ -23,7 +23,61 @@ from sortedcontainers import SortedList
 
 _INF = math.inf
 
-__all__ = ["CalendarEventQueue", "EventQueue", "HeapEventQueue"]
+__all__ = ["CalendarEventQueue", "EventQueue", "HeapEventQueue", "sift_down", "sift_up"]
+
+
+# --- an indexed binary heap over arrays, for the compiled loops ---------------------------------------------
+# ``heap[k]`` is the owner at position k and ``ht[k]`` its time (kept beside it, so that a comparison reads no
+# other array); ``hpos[owner]`` is the owner's position. Ordered by ``(time, owner)``, as every queue here. Plain
+# Python on anything indexable: the compiled event loop and the compression loop jit these very functions.
+def sift_up(k, heap, ht, hpos):
+    """Move the entry at position ``k`` towards the root until its parent is earlier."""
+    owner = heap[k]
+    t = ht[k]
+    while k > 0:
+        parent = (k - 1) >> 1
+        pt = ht[parent]
+        p = heap[parent]
+        if t < pt or (t == pt and owner < p):
+            heap[k] = p
+            ht[k] = pt
+            hpos[p] = k
+            k = parent
+        else:
+            break
+    heap[k] = owner
+    ht[k] = t
+    hpos[owner] = k
+
+
+def sift_down(k, size, heap, ht, hpos):
+    """Move the entry at position ``k`` away from the root (the heap holds ``size`` entries) until its children
+    are later."""
+    owner = heap[k]
+    t = ht[k]
+    while True:
+        child = 2 * k + 1
+        if child >= size:
+            break
+        c = heap[child]
+        ct = ht[child]
+        if child + 1 < size:
+            d = heap[child + 1]
+            dt = ht[child + 1]
+            if dt < ct or (dt == ct and d < c):
+                child += 1
+                c = d
+                ct = dt
+        if ct < t or (ct == t and c < owner):
+            heap[k] = c
+            ht[k] = ct
+            hpos[c] = k
+            k = child
+        else:
+            break
+    heap[k] = owner
+    ht[k] = t
+    hpos[owner] = k
 
 
 class EventQueue:

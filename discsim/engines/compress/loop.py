@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import math
 
+from discsim.queue import sift_down, sift_up  # the indexed heap (by (time, owner)) of the compiled loops
+
 INF = math.inf
 COLLISION, WALL, CROSSING, NONE = 0, 1, 2, 3
 # Walls (``qo`` of a wall event) and crossing directions (``qo`` of a crossing).
@@ -57,52 +59,6 @@ def growing_time_of_impact(dx, dy, dvx, dvy, s, sp):
     if d < 0.0:  # c < 0 by roundoff: the smaller root stands for the contact
         d = 0.0
     return (b + math.sqrt(d)) / -a
-
-
-def sift_up(k, heap, ht, hpos):
-    owner = heap[k]
-    t = ht[k]
-    while k > 0:
-        parent = (k - 1) >> 1
-        pt = ht[parent]
-        p = heap[parent]
-        if t < pt or (t == pt and owner < p):
-            heap[k] = p
-            ht[k] = pt
-            hpos[p] = k
-            k = parent
-        else:
-            break
-    heap[k] = owner
-    ht[k] = t
-    hpos[owner] = k
-
-
-def sift_down(k, size, heap, ht, hpos):
-    owner = heap[k]
-    t = ht[k]
-    while True:
-        child = 2 * k + 1
-        if child >= size:
-            break
-        ct = ht[child]
-        c = heap[child]
-        right = child + 1
-        if right < size:
-            rt = ht[right]
-            r = heap[right]
-            if rt < ct or (rt == ct and r < c):
-                child, ct, c = right, rt, r
-        if ct < t or (ct == t and c < owner):
-            heap[k] = c
-            ht[k] = ct
-            hpos[c] = k
-            k = child
-        else:
-            break
-    heap[k] = owner
-    ht[k] = t
-    hpos[owner] = k
 
 
 def set_time(i, t, n, heap, ht, hpos):

@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from discsim._compiled import jit, prefetch, reflect_off_segment, segment_time_of_impact
+from discsim.queue import sift_down, sift_up
 
 INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT = 0, 1, 2, 3
@@ -46,53 +47,8 @@ DONE, MORE, CROSSINGS = 0, 1, 2
 # ``heap[k]`` is the owner at position k and ``ht[k]`` its time (kept beside it, so that a comparison reads
 # no other array); ``hpos[owner]`` is the owner's position, -1 when it has no pending event, so an
 # owner's pending time is ``ht[hpos[owner]]``.
-@jit
-def _sift_up(k, heap, ht, hpos):
-    owner = heap[k]
-    t = ht[k]
-    while k > 0:
-        parent = (k - 1) >> 1
-        pt = ht[parent]
-        p = heap[parent]
-        if t < pt or (t == pt and owner < p):
-            heap[k] = p
-            ht[k] = pt
-            hpos[p] = k
-            k = parent
-        else:
-            break
-    heap[k] = owner
-    ht[k] = t
-    hpos[owner] = k
-
-
-@jit
-def _sift_down(k, size, heap, ht, hpos):
-    owner = heap[k]
-    t = ht[k]
-    while True:
-        child = 2 * k + 1
-        if child >= size:
-            break
-        c = heap[child]
-        ct = ht[child]
-        if child + 1 < size:
-            d = heap[child + 1]
-            dt = ht[child + 1]
-            if dt < ct or (dt == ct and d < c):
-                child += 1
-                c = d
-                ct = dt
-        if ct < t or (ct == t and c < owner):
-            heap[k] = c
-            ht[k] = ct
-            hpos[c] = k
-            k = child
-        else:
-            break
-    heap[k] = owner
-    ht[k] = t
-    hpos[owner] = k
+_sift_up = jit(sift_up)
+_sift_down = jit(sift_down)
 
 
 @jit
@@ -444,6 +400,22 @@ def _prefetch_disc(c, rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, 
 
 
 @jit
+def _next_cell(c, direction, nx, ny):
+    """The cell next to ``c`` in ``direction`` (``PLUS_X`` ...), across a periodic edge too."""
+    cx = c // ny
+    cy = c - cx * ny
+    if direction == PLUS_X:
+        cx = cx + 1 if cx + 1 < nx else 0
+    elif direction == MINUS_X:
+        cx = cx - 1 if cx > 0 else nx - 1
+    elif direction == PLUS_Y:
+        cy = cy + 1 if cy + 1 < ny else 0
+    else:
+        cy = cy - 1 if cy > 0 else ny - 1
+    return cx * ny + cy
+
+
+@jit
 def _prefetch_cells(c, head, nx, ny):
     """Start fetching the heads of the 3 x 3 cells around cell ``c`` (three runs of three in memory)."""
     cx = c // ny
@@ -521,7 +493,10 @@ def run_events(
             _prefetch_disc(heap[k], rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
         if qk[i] == COLLISION:
             _prefetch_disc(qo[i], rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
-        _prefetch_cells(cell[i], head, nx, ny)
+        c = cell[i]
+        if qk[i] == CROSSING:  # the cells around the one it enters
+            c = _next_cell(c, qo[i], nx, ny)
+        _prefetch_cells(c, head, nx, ny)
         # The event stays at the top of the heap: predicting i again, as every branch below does,
         # replaces it (see push).
         kind = qk[i]

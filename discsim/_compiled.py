@@ -12,7 +12,7 @@ import math
 from discsim import kernels
 from discsim._numba import numba
 
-__all__ = ["jit", "prefetch", "reflect_off_segment", "segment_time_of_impact", "time_of_impact"]
+__all__ = ["inline", "jit", "prefetch", "reflect_off_segment", "segment_time_of_impact", "time_of_impact"]
 
 _nb = numba()
 if _nb is None:
@@ -23,6 +23,8 @@ if _nb is None:
     def prefetch(array, offset):
         """Without numba: nothing to fetch."""
 
+    inline = jit
+
 else:
     from llvmlite import ir
     from numba.core import cgutils, types
@@ -32,6 +34,9 @@ else:
     # error_model="numpy": a division by zero gives inf or nan instead of a check on every division (the
     # loops divide only by numbers they have tested, as the Python code does).
     jit = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+    #: ``jit`` for a function compiled into each of its callers (numba's own inlining): a call between compiled
+    #: functions passes every array argument as a struct of seven words, which a hot loop pays on every event.
+    inline = _nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline="always")
 
     @intrinsic
     def prefetch(typingctx, array, offset):

@@ -58,8 +58,9 @@ class NumbaBackend:
         self._lp = _loop()
         box = self.box
         nx, ny = grid.nx, grid.ny
-        self._col_lo = np.append(np.arange(nx) * grid.lx, box.width)
-        self._row_lo = np.append(np.arange(ny) * grid.ly, box.height)
+        # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides
+        # and the box's height (one array: a compiled call passes each array as seven words).
+        self._edges = np.concatenate([np.arange(nx) * grid.lx, [box.width], np.arange(ny) * grid.ly, [box.height]])
         segments = scene.segments
         if segments:
             self._seg = np.array([[*s.p0.tolist(), *s.p1.tolist()] for s in segments], dtype=np.float64)
@@ -378,7 +379,7 @@ class NumbaBackend:
     # --- argument lists of the compiled functions --------------------------------------------
     def _geometry(self) -> tuple:
         grid, box = self.grid, self.box
-        return (grid.nx, grid.ny, float(box.width), float(box.height), bool(box.periodic), self._col_lo, self._row_lo)
+        return (grid.nx, grid.ny, float(box.width), float(box.height), bool(box.periodic), self._edges)
 
     def _filter(self) -> tuple:
         return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)

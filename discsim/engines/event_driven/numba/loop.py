@@ -2,7 +2,10 @@
 
 Imported only by :class:`~discsim.engines.event_driven.numba.backend.NumbaBackend`, and only when numba
 imports (``discsim._numba``). Every function is ``njit(cache=True)``: the first process compiles them
-(seconds) and writes machine code next to this file's ``__pycache__``; later processes load it.
+(seconds) and writes machine code next to this file's ``__pycache__``; later processes load it. Those the
+loop calls on every event (``predict``, ``push`` and its heap removal, the prefetches) are ``inline``: compiled
+into each caller, since a call between compiled functions passes every array argument as a struct of seven
+words (``predict`` takes twenty arrays), which cost 1.24x at N = 10^4 (a first compile 8 s longer).
 
 The algorithm, the order of the floating-point operations and the tie-breaking are those of
 :mod:`discsim.engines.event_driven.python.backend`, so both backends give the same events bit for bit;
@@ -24,7 +27,7 @@ import math
 
 import numpy as np
 
-from discsim._compiled import jit, prefetch, reflect_off_segment, segment_time_of_impact
+from discsim._compiled import inline, jit, prefetch, reflect_off_segment, segment_time_of_impact
 from discsim.queue import sift_down, sift_up
 
 INF = math.inf
@@ -51,7 +54,7 @@ _sift_up = jit(sift_up)
 _sift_down = jit(sift_down)
 
 
-@jit
+@inline
 def _remove(owner, heap, ht, hpos, ints):
     """Take ``owner``'s event out of the heap (it must be there)."""
     k = hpos[owner]
@@ -71,7 +74,7 @@ def _remove(owner, heap, ht, hpos, ints):
         _sift_down(k, size, heap, ht, hpos)
 
 
-@jit
+@inline
 def push(owner, t, kind, other, stamp, heap, ht, hpos, qk, qo, qs, ints):
     """Schedule ``owner``'s event at ``t`` (finite), replacing its pending one.
 
@@ -115,11 +118,11 @@ def heapify(heap, ht, hpos, ints):
 
 
 # --- prediction ----------------------------------------------------------------------------------------
-@jit
+@inline
 def predict(
     i, t, exclude, direction,
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
-    nx, ny, width, height, periodic, col_lo, row_lo,
+    nx, ny, width, height, periodic, edges,
     seg, seg_start, seg_idx, filtering, group, blocked,
     heap, ht, hpos, qk, qo, qs, ints,
 ):  # fmt: skip
@@ -230,14 +233,14 @@ def predict(
             best = (width - ri - xi) / vxi
             kind = WALL
         else:
-            best = (col_lo[cx + 1] - xi) / vxi
+            best = (edges[cx + 1] - xi) / vxi
             other = PLUS_X
     elif vxi < 0.0:
         if not periodic and cx == 0:
             best = (ri - xi) / vxi
             kind = WALL
         else:
-            best = (col_lo[cx] - xi) / vxi
+            best = (edges[cx] - xi) / vxi
             other = MINUS_X
     if vyi > 0.0:
         if not periodic and cy == ny - 1:
@@ -245,7 +248,7 @@ def predict(
             if ty < best:
                 best, kind, other = ty, WALL, 1
         else:
-            ty = (row_lo[cy + 1] - yi) / vyi
+            ty = (edges[nx + 2 + cy] - yi) / vyi
             if ty < best:
                 best, kind, other = ty, CROSSING, PLUS_Y
     elif vyi < 0.0:
@@ -254,7 +257,7 @@ def predict(
             if ty < best:
                 best, kind, other = ty, WALL, 1
         else:
-            ty = (row_lo[cy] - yi) / vyi
+            ty = (edges[nx + 1 + cy] - yi) / vyi
             if ty < best:
                 best, kind, other = ty, CROSSING, MINUS_Y
     for m in range(seg_start[c], seg_start[c + 1]):
@@ -278,7 +281,7 @@ def predict(
 @jit
 def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
-    nx, ny, width, height, periodic, col_lo, row_lo,
+    nx, ny, width, height, periodic, edges,
     seg, seg_start, seg_idx, filtering, group, blocked,
     heap, ht, hpos, qk, qo, qs, ints,
 ):  # fmt: skip
@@ -287,7 +290,7 @@ def predict_all(
         if rec[i, M] != INF:
             predict(
                 i, 0.0, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                nx, ny, width, height, periodic, col_lo, row_lo,
+                nx, ny, width, height, periodic, edges,
                 seg, seg_start, seg_idx, filtering, group, blocked,
                 heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
@@ -298,7 +301,7 @@ def predict_all(
 def set_disc(
     i, x, y, vx, vy, new_cell, t,
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
-    nx, ny, width, height, periodic, col_lo, row_lo,
+    nx, ny, width, height, periodic, edges,
     seg, seg_start, seg_idx, filtering, group, blocked,
     heap, ht, hpos, qk, qo, qs, ints,
 ):  # fmt: skip
@@ -317,7 +320,7 @@ def set_disc(
     count[i] += 1
     predict(
         i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-        nx, ny, width, height, periodic, col_lo, row_lo,
+        nx, ny, width, height, periodic, edges,
         seg, seg_start, seg_idx, filtering, group, blocked,
         heap, ht, hpos, qk, qo, qs, ints,
     )  # fmt: skip
@@ -385,7 +388,7 @@ def _enter(i, c, head, nxt):
     nxt[j] = i
 
 
-@jit
+@inline
 def _prefetch_disc(c, rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs):
     """Ask for every record of disc ``c`` that an event of it reads (see :func:`discsim._compiled.prefetch`)."""
     prefetch(rec, c * 8)
@@ -415,7 +418,7 @@ def _next_cell(c, direction, nx, ny):
     return cx * ny + cy
 
 
-@jit
+@inline
 def _prefetch_cells(c, head, nx, ny):
     """Start fetching the heads of the 3 x 3 cells around cell ``c`` (three runs of three in memory)."""
     cx = c // ny
@@ -445,7 +448,7 @@ def rebase(shift, rec, heap, ht, hpos, ints, floats):
 def run_events(
     until, limit, crossings, budget, rebase_every, recording,
     rec, count, order, images, kept_partner, kept_stamp, cell, head, nxt,
-    nx, ny, width, height, periodic, col_lo, row_lo,
+    nx, ny, width, height, periodic, edges,
     seg, seg_start, seg_idx, filtering, group, blocked,
     heap, ht, hpos, qk, qo, qs, ints, floats,
     ev_t, ev_kind, ev_i, ev_j, ev_f,
@@ -507,7 +510,7 @@ def run_events(
                 n_stale += 1
                 predict(
                     i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                    nx, ny, width, height, periodic, col_lo, row_lo,
+                    nx, ny, width, height, periodic, edges,
                     seg, seg_start, seg_idx, filtering, group, blocked,
                     heap, ht, hpos, qk, qo, qs, ints,
                 )  # fmt: skip
@@ -563,7 +566,7 @@ def run_events(
                 logged += 1
             predict(
                 i, t, j, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                nx, ny, width, height, periodic, col_lo, row_lo,
+                nx, ny, width, height, periodic, edges,
                 seg, seg_start, seg_idx, filtering, group, blocked,
                 heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
@@ -571,7 +574,7 @@ def run_events(
                 count[j] += 1
                 predict(
                     j, t, i, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                    nx, ny, width, height, periodic, col_lo, row_lo,
+                    nx, ny, width, height, periodic, edges,
                     seg, seg_start, seg_idx, filtering, group, blocked,
                     heap, ht, hpos, qk, qo, qs, ints,
                 )  # fmt: skip
@@ -609,7 +612,7 @@ def run_events(
                 logged += 1
             predict(
                 i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                nx, ny, width, height, periodic, col_lo, row_lo,
+                nx, ny, width, height, periodic, edges,
                 seg, seg_start, seg_idx, filtering, group, blocked,
                 heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip
@@ -649,7 +652,7 @@ def run_events(
             n_cross += 1
             predict(
                 i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                nx, ny, width, height, periodic, col_lo, row_lo,
+                nx, ny, width, height, periodic, edges,
                 seg, seg_start, seg_idx, filtering, group, blocked,
                 heap, ht, hpos, qk, qo, qs, ints,
             )  # fmt: skip

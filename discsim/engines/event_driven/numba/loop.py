@@ -195,19 +195,22 @@ def predict(
                 dtj = t - rec[j, T]
                 dx = rec[j, X] + vxj * dtj + offx
                 dy = rec[j, Y] + vyj * dtj + offy
+                # The Python backend's time of impact, computed for every candidate and then selected
+                # (approaching, touching, missing) instead of branched on: whether a pair approaches is a coin
+                # toss the CPU cannot predict, and a 1:10 mixture's cells hold ten times the candidates
+                # (1.19x there). Where it is used, each value is the same expression, so the same bits.
                 b = dx * dvx + dy * dvy
-                if b < 0.0:
-                    s = ri + rec[j, R]
-                    cc = dx * dx + dy * dy - s * s
-                    if cc <= 0.0:
-                        tij = 0.0
-                    else:
-                        a = dvx * dvx + dvy * dvy
-                        d = b * b - a * cc
-                        tij = cc / (-b + math.sqrt(d)) if d > 0.0 else INF
-                    if tij < best:
-                        best = tij
-                        new_partner = j
+                s = ri + rec[j, R]
+                cc = dx * dx + dy * dy - s * s
+                a = dvx * dvx + dvy * dvy
+                d = b * b - a * cc
+                root = cc / (-b + math.sqrt(max(d, 0.0)))
+                tij = root if d > 0.0 else INF
+                tij = 0.0 if cc <= 0.0 else tij
+                tij = tij if b < 0.0 else INF
+                if tij < best:
+                    best = tij
+                    new_partner = j
                 j = nxt[j]
     if after_crossing:
         t_hit = rec[i, KEPT]

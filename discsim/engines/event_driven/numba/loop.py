@@ -492,21 +492,21 @@ def run_events(
         if t > horizon:
             break
         pops += 1
+        kind = qk[i]
+        other = qo[i]
         # At large N every record below waits for memory, and the next disc is known only when the queue
         # pops it: ask now for the records of this event's partner and its cells, and of the two events
         # most likely next (the heap's second and third), so that the fetches overlap (no effect on results).
         for k in range(1, min(3, ints[I_SIZE])):
             _prefetch_disc(heap[k], rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
-        if qk[i] == COLLISION:
-            _prefetch_disc(qo[i], rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
+        if kind == COLLISION:
+            _prefetch_disc(other, rec, count, kept_partner, kept_stamp, cell, hpos, qk, qo, qs)
         c = cell[i]
-        if qk[i] == CROSSING:  # the cells around the one it enters
-            c = _next_cell(c, qo[i], nx, ny)
+        if kind == CROSSING:  # the cells around the one it enters
+            c = _next_cell(c, other, nx, ny)
         _prefetch_cells(c, head, nx, ny)
         # The event stays at the top of the heap: predicting i again, as every branch below does,
         # replaces it (see push).
-        kind = qk[i]
-        other = qo[i]
         if kind == COLLISION:
             j = other
             if count[j] != qs[i]:  # the partner has changed course since the prediction

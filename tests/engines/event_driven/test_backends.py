@@ -84,6 +84,17 @@ def test_the_first_ten_thousand_events_of_a_gas_are_identical(periodic, packing)
 
 
 @needs_numba
+@pytest.mark.parametrize("periodic", [True, False])
+def test_a_one_to_ten_mixture_gives_identical_events(periodic):
+    """Cells a large disc wide hold ten small discs each: the compiled scan's early test of a hit."""
+    discs, box = ds.random_gas(1000, 0.08, periodic=periodic, seed=5, radii=[1.0, 10.0], fractions=[0.9, 0.1])
+    a, b = _both(discs, box, lambda s: s.run(events=10_000))
+    assert a.counts["collisions"] > 5000
+    assert_identical(a, b)
+    b._check()
+
+
+@needs_numba
 def test_every_feature_gives_identical_events():
     """Segments, pass-through groups, obstacles, radii and masses of any mix, in one walled scene."""
     rng = np.random.default_rng(3)

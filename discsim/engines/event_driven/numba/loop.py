@@ -195,22 +195,21 @@ def predict(
                 dtj = t - rec[j, T]
                 dx = rec[j, X] + vxj * dtj + offx
                 dy = rec[j, Y] + vyj * dtj + offy
-                # The Python backend's time of impact, computed for every candidate and then selected
-                # (approaching, touching, missing) instead of branched on: whether a pair approaches is a coin
-                # toss the CPU cannot predict, and a 1:10 mixture's cells hold ten times the candidates
-                # (1.19x there). Where it is used, each value is the same expression, so the same bits.
+                # The Python backend's time of impact, the same expressions (so the same bits). A candidate hits
+                # when it approaches (b < 0) and its path reaches contact (d > 0) or it touches (cc <= 0): about
+                # 6% of a 1:10 mixture's candidates, so one branch on that is well predicted and spares the rest
+                # the square root and the division (1.12x there, 1.05x for one size). The test is one min() of
+                # floats: written with `and` or `&`, LLVM branches on b < 0 first, a coin toss (0.8x).
                 b = dx * dvx + dy * dvy
                 s = ri + rec[j, R]
                 cc = dx * dx + dy * dy - s * s
                 a = dvx * dvx + dvy * dvy
                 d = b * b - a * cc
-                root = cc / (-b + math.sqrt(max(d, 0.0)))
-                tij = root if d > 0.0 else INF
-                tij = 0.0 if cc <= 0.0 else tij
-                tij = tij if b < 0.0 else INF
-                if tij < best:
-                    best = tij
-                    new_partner = j
+                if min(-b, d if cc > 0.0 else 1.0) > 0.0:
+                    tij = 0.0 if cc <= 0.0 else cc / (-b + math.sqrt(d))
+                    if tij < best:
+                        best = tij
+                        new_partner = j
                 j = nxt[j]
     if after_crossing:
         t_hit = rec[i, KEPT]

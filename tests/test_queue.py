@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 import random
 
+import numpy as np
 import pytest
-from hypothesis import HealthCheck, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule
 
@@ -308,3 +309,48 @@ def test_empty_queue(cls):
     q.push(0, 2.0, "y")
     assert q.pop_before(1.0) is None and q.pop_before(2.0) == (2.0, 0, "y")
     q._check()
+
+
+# --- the compiled event loop's queue: each disc's pending time and a heap of blocks of discs ----------------
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    n=st.integers(1, 200),
+    ops=st.lists(
+        st.tuples(st.integers(0, 199), st.sampled_from([*(k / 4 for k in range(13)), math.inf, -1.0]), st.booleans()),
+        max_size=300,
+    ),
+)
+def test_the_compiled_loops_queue_pops_the_earliest_time_then_the_lowest_disc(n, ops):
+    """``push``, ``discard``, a pop and ``reblock`` (after the clock's origin moves) against a dict, with many
+    equal times across and within blocks (compiled when numba is there, plain Python otherwise)."""
+    from discsim.engines.event_driven.numba import loop as lp
+
+    n_blocks = (n + lp.BLOCK - 1) >> lp.BLOCK_SHIFT
+    qt = np.full(n_blocks << lp.BLOCK_SHIFT, np.inf)
+    bheap, bht = np.zeros(n_blocks, np.int32), np.zeros(n_blocks)
+    bpos, barg = np.zeros(n_blocks, np.int32), np.zeros(n_blocks, np.int32)
+    qk, qo, qs, ints = np.zeros(n, np.int8), np.zeros(n, np.int32), np.zeros(n, np.int64), np.zeros(lp.N_INTS, np.int64)
+    lp.reblock(qt, bheap, bht, bpos, barg)
+    model: dict[int, float] = {}
+    for owner, t, pop in ops:
+        owner %= n
+        if pop and model:
+            first = min((time, o) for o, time in model.items())
+            assert (float(bht[0]), int(barg[bheap[0]])) == first
+            lp.discard(first[1], qt, bheap, bht, bpos, barg, ints)
+            del model[first[1]]
+        elif t == -1.0:  # the clock's origin moves: every time shifts, ties may appear
+            qt -= 0.25
+            model = {o: time - 0.25 for o, time in model.items()}
+            lp.reblock(qt, bheap, bht, bpos, barg)
+        elif t == math.inf:
+            lp.discard(owner, qt, bheap, bht, bpos, barg, ints)
+            model.pop(owner, None)
+        else:
+            lp.push(owner, t, 2, owner, 7, qt, bheap, bht, bpos, barg, qk, qo, qs, ints)
+            model[owner] = t
+            assert (qk[owner], qo[owner], qs[owner]) == (2, owner, 7)
+        assert ints[lp.I_SIZE] == len(model)
+        assert np.array_equal(np.flatnonzero(qt != np.inf), sorted(model))
+        if model:
+            assert (float(bht[0]), int(barg[bheap[0]])) == min((time, o) for o, time in model.items())

@@ -43,8 +43,9 @@ class NumbaBackend:
     Args:
         scene: the validated scene.
         grid: the cell grid (cells at least one largest diameter a side).
-        queue: the queue the caller asked for; this backend always uses one array-based binary heap,
-            which pops events in the same ``(time, disc)`` order as every Python queue.
+        queue: the queue the caller asked for; this backend always uses its array-based queue (each disc's
+            pending time and a binary heap of blocks of discs), which pops events in the same ``(time, disc)``
+            order as every Python queue.
     """
 
     name = "numba"
@@ -111,7 +112,7 @@ class NumbaBackend:
         self._nxt = np.full(n, -1, dtype=np.int32)
         members = rank[state.cell_members] if n else np.zeros(0, dtype=np.int64)
         lp.link(members, state.cell_sizes.astype(np.int64), self._head, self._nxt)
-        # The queue: one slot per disc, and the heap of the discs with a pending event.
+        # The queue: one slot per disc (time, kind, other, stamp), and the heap of blocks of discs.
         owners = rank[state.queue_owner] if len(state.queue_owner) else np.zeros(0, dtype=np.int64)
         self._qk = np.zeros(n, dtype=np.int8)
         self._qo = np.zeros(n, dtype=np.int32)
@@ -120,16 +121,17 @@ class NumbaBackend:
         collision = state.queue_kind == _COLLISION
         self._qo[owners] = np.where(collision, rank[np.where(collision, state.queue_other, 0)], state.queue_other)
         self._qs[owners] = state.queue_stamp
-        self._heap = np.zeros(n, dtype=np.int32)
-        self._heap[: len(owners)] = owners
-        self._ht = np.zeros(n)
-        self._ht[: len(owners)] = state.queue_time
-        self._hpos = np.full(n, -1, dtype=np.int32)
-        lp = self._lp
+        n_blocks = (n + lp.BLOCK - 1) >> lp.BLOCK_SHIFT
+        self._qt = np.full(n_blocks << lp.BLOCK_SHIFT, np.inf)  # padded to whole blocks with discs of no event
+        self._qt[owners] = state.queue_time
+        self._bheap = np.zeros(n_blocks, dtype=np.int32)
+        self._bht = np.zeros(n_blocks)
+        self._bpos = np.zeros(n_blocks, dtype=np.int32)
+        self._barg = np.zeros(n_blocks, dtype=np.int32)
+        lp.reblock(self._qt, self._bheap, self._bht, self._bpos, self._barg)
         ints = self._ints = np.zeros(lp.N_INTS, dtype=np.int64)
         floats = self._floats = np.zeros(lp.N_FLOATS)
         ints[lp.I_SIZE] = len(owners)
-        lp.heapify(self._heap, self._ht, self._hpos, ints)
         ints[lp.I_PRED] = state.predictions
         ints[lp.I_COLL] = state.collisions
         ints[lp.I_WALL] = state.wall_hits
@@ -167,7 +169,7 @@ class NumbaBackend:
         members = np.zeros(n, dtype=np.int64)
         sizes = np.zeros(len(self.grid), dtype=np.int64)
         lp.unlink(self._head, self._nxt, members, sizes)
-        owners = np.flatnonzero(self._hpos >= 0)
+        owners = np.flatnonzero(self._qt[:n] != np.inf)
         kinds = self._qk[owners].astype(np.int64)
         others = self._qo[owners].astype(np.int64)
         partner = self._kept_partner
@@ -207,7 +209,7 @@ class NumbaBackend:
             kept_stamp=caller(self._kept_stamp),
             order=order.astype(np.int64),
             queue_owner=order[owners].astype(np.int64),
-            queue_time=self._ht[self._hpos[owners]],
+            queue_time=self._qt[owners],
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.where(kinds == _COLLISION, others, 0)], others),
             queue_stamp=self._qs[owners].copy(),
@@ -349,7 +351,7 @@ class NumbaBackend:
         arrays = (
             self._rec, self._count, self._images, self._kept_partner, self._kept_stamp, self._cell,
             self._head, self._nxt, self._qk, self._qo, self._qs,
-            self._heap, self._ht, self._hpos, self._order, self._group,
+            self._qt, self._bheap, self._bht, self._bpos, self._barg, self._order, self._group,
         )  # fmt: skip
         return sum(a.nbytes for a in arrays)
 
@@ -358,17 +360,23 @@ class NumbaBackend:
         return int(self._ints[self._lp.I_SIZE])
 
     def queue_storage(self) -> int:
-        """Entries the queue holds: one slot per pending event (the heap holds no dead entries)."""
+        """Entries the queue holds: one slot per pending event (no dead entries)."""
         return self.queue_size()
 
     def _check(self) -> None:
-        """Assert the backend's own invariants (heap order and positions, linked cells); O(N)."""
-        size, heap, hpos, times = self.queue_size(), self._heap, self._hpos, self._ht
-        owners = heap[:size]
-        assert np.array_equal(hpos[owners], np.arange(size)), "heap positions out of date"
-        assert (hpos >= 0).sum() == size and np.isfinite(times[:size]).all()
-        parent = (np.arange(1, size) - 1) >> 1
-        pt, ct, po, co = times[parent], times[1:size], owners[parent], owners[1:]
+        """Assert the backend's own invariants (each block's earliest event, the heap of blocks, linked cells); O(N)."""
+        qt, n = self._qt, len(self._order)
+        assert np.isinf(qt[n:]).all() and np.count_nonzero(qt != np.inf) == self.queue_size(), "queue size out of date"
+        blocks = qt.reshape(-1, self._lp.BLOCK)
+        first = blocks.min(axis=1)
+        assert np.array_equal(self._bht[self._bpos], first), "a block's time out of date"
+        earliest = np.argmax(blocks == first[:, None], axis=1) + np.arange(len(blocks)) * self._lp.BLOCK
+        finite = first != np.inf
+        assert np.array_equal(self._barg[finite], earliest[finite]), "a block's earliest disc out of date"
+        heap, times = self._bheap, self._bht
+        assert np.array_equal(heap[self._bpos], np.arange(len(heap))), "heap positions out of date"
+        parent = (np.arange(1, len(heap)) - 1) >> 1
+        pt, ct, po, co = times[parent], times[1:], heap[parent], heap[1:]
         ordered = (pt < ct) | ((pt == ct) & (po < co))
         assert ordered.all(), "heap order broken"
         members = np.zeros(len(self._order), dtype=np.int64)
@@ -379,13 +387,13 @@ class NumbaBackend:
     # --- argument lists of the compiled functions --------------------------------------------
     def _geometry(self) -> tuple:
         grid, box = self.grid, self.box
-        return (grid.nx, grid.ny, float(box.width), float(box.height), bool(box.periodic), self._edges)
+        return (grid.nx, grid.ny, bool(box.periodic), self._edges)
 
     def _filter(self) -> tuple:
         return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)
 
     def _queue(self) -> tuple:
-        return (self._heap, self._ht, self._hpos, self._qk, self._qo, self._qs, self._ints)
+        return (self._qt, self._bheap, self._bht, self._bpos, self._barg, self._qk, self._qo, self._qs, self._ints)
 
     def _predict_args(self) -> tuple:
         return (

@@ -3,9 +3,11 @@
 Imported only by :class:`~discsim.engines.event_driven.numba.backend.NumbaBackend`, and only when numba
 imports (``discsim._numba``). Every function is ``njit(cache=True)``: the first process compiles them
 (seconds) and writes machine code next to this file's ``__pycache__``; later processes load it. Those the
-loop calls on every event (``predict``, ``push`` and its heap removal, the prefetches) are ``inline``: compiled
+loop calls on every event with many arrays (``predict``, ``push``, the prefetches) are ``inline``: compiled
 into each caller, since a call between compiled functions passes every array argument as a struct of seven
-words (``predict`` takes twenty arrays), which cost 1.24x at N = 10^4 (a first compile 8 s longer).
+words (``predict`` takes twenty arrays), which cost 1.24x at N = 10^4 (a first compile 8 s longer). The
+queue's block updates stay calls: inlined too, they made the loop larger and slower (0.94x at N = 10^4) and
+the first compile 12 s longer.
 
 The algorithm, the order of the floating-point operations and the tie-breaking are those of
 :mod:`discsim.engines.event_driven.python.backend`, so both backends give the same events bit for bit;
@@ -55,14 +57,14 @@ DONE, MORE, CROSSINGS = 0, 1, 2
 # moved (and re-indexed) a random owner per level, about twenty levels at N = 10^6, each a cache miss (a quarter
 # of the loop's time there); a disc's new time here rescans its block (16 times in a row, with selects: which is
 # earlier is a coin toss) and sifts a heap 16 times smaller, which stays in cache. Blocks of 16 against the heap
-# of owners: 1.18x at N = 10^6, 1.05x at 10^4 (blocks of 8 and 32 did less).
+# of owners: 1.17x at N = 10^6, 1.12x at 10^4 (blocks of 8 and 32 did less).
 BLOCK_SHIFT = 4
 BLOCK = 1 << BLOCK_SHIFT
 _sift_up = jit(sift_up)
 _sift_down = jit(sift_down)
 
 
-@inline
+@jit
 def _earliest(b, qt):
     """Block ``b``'s earliest ``(time, owner)``: the lowest owner among equal times (inf and the block's first
     owner when it has no event)."""
@@ -76,7 +78,7 @@ def _earliest(b, qt):
     return best, owner
 
 
-@inline
+@jit
 def _moved(b, t, owner, bheap, bht, bpos, barg):
     """Block ``b``'s earliest event is now ``owner``'s at ``t``: restore the heap."""
     k = bpos[b]
@@ -111,7 +113,7 @@ def push(owner, t, kind, other, stamp, qt, bheap, bht, bpos, barg, qk, qo, qs, i
         _moved(b, first, o, bheap, bht, bpos, barg)
 
 
-@inline
+@jit
 def discard(owner, qt, bheap, bht, bpos, barg, ints):
     """Drop ``owner``'s pending event, if any."""
     if qt[owner] != INF:

@@ -29,7 +29,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ab_throughput import _PROBE, NEW_TREE, SIDES, tree_label, warmup_collisions
-from benchutils import DEFAULT_RESULTS, Column, announce, format_table, machine_summary, write_csv
+from benchutils import Column, announce, format_table, machine_summary, results_folder, write_csv
 
 FULL = {"sizes": [1_000, 10_000], "packings": [0.3, 0.7], "short": 20_000, "long": 60_000}
 QUICK = {"sizes": [200], "packings": [0.3], "short": 500, "long": 1_500}
@@ -74,8 +74,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--sizes", type=int, nargs="+")
     parser.add_argument("--packings", type=float, nargs="+")
     parser.add_argument("--quick", action="store_true", help="a tiny run that proves the script works")
-    parser.add_argument("--out", type=Path, default=DEFAULT_RESULTS)
+    parser.add_argument("--out", type=Path, help="CSV and PNG folder (default results/; --quick: a temporary one)")
     args = parser.parse_args(argv)
+    args.out = results_folder(args.out, args.quick)
     if shutil.which("valgrind") is None:
         print("valgrind is not installed (apt-get install valgrind); nothing measured", file=sys.stderr)
         return 1

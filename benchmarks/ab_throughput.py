@@ -52,7 +52,7 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from benchutils import DEFAULT_RESULTS, Column, announce, format_table, machine_summary, median, write_csv
+from benchutils import Column, announce, format_table, machine_summary, median, results_folder, write_csv
 
 #: The tree this script belongs to: the "new" side.
 NEW_TREE = Path(__file__).resolve().parent.parent
@@ -254,7 +254,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--repeats", type=int, help=f"pairs of runs per point (default {FULL['repeats']})")
     parser.add_argument("--collisions", type=int, help=f"timed collisions per run (default {FULL['collisions']:,})")
     parser.add_argument("--quick", action="store_true", help=f"{QUICK}: proves the script runs")
-    parser.add_argument("--out", type=Path, default=DEFAULT_RESULTS, help="folder for the CSV and PNG")
+    parser.add_argument("--out", type=Path, help="CSV and PNG folder (default results/; --quick: a temporary one)")
     args = parser.parse_args(argv)
     defaults = QUICK if args.quick else FULL
     for key, value in defaults.items():
@@ -268,7 +268,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
             parser.error(f"--{key} must be at least 1, got {getattr(args, key)}")
     if min(args.sizes) < 1:
         parser.error(f"--sizes must be at least 1, got {min(args.sizes)}")
-    args.out.mkdir(parents=True, exist_ok=True)
+    args.out = results_folder(args.out, args.quick)
     return args
 
 

@@ -18,6 +18,7 @@ import signal
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
@@ -36,6 +37,7 @@ __all__ = [
     "median",
     "parse_args",
     "peak_resident_mb",
+    "results_folder",
     "time_limit",
     "timed",
     "write_csv",
@@ -53,18 +55,36 @@ def parse_args(description: str, argv: Sequence[str] | None = None) -> argparse.
         argv: arguments to parse (default ``sys.argv[1:]``).
 
     Returns:
-        The namespace; ``results`` is a :class:`~pathlib.Path` that exists, and
-        ``repeats`` is None unless given.
+        The namespace; ``results`` is a :class:`~pathlib.Path` that exists (``benchmarks/results/`` unless given, or
+        for ``--quick`` a new temporary folder), and ``repeats`` is None unless given.
     """
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--quick", action="store_true", help="tiny sizes and one repeat: proves the script runs")
-    parser.add_argument("--results", type=Path, default=DEFAULT_RESULTS, help="folder for CSV and PNG output")
+    parser.add_argument(
+        "--results",
+        type=Path,
+        default=None,
+        help="folder for CSV and PNG output (default: benchmarks/results/; with --quick a new temporary folder, so "
+        "that a smoke run never overwrites measured results)",
+    )
     parser.add_argument("--repeats", type=int, default=None, help="timed runs per measurement (median reported)")
     args = parser.parse_args(argv)
     if args.repeats is not None and args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
-    args.results.mkdir(parents=True, exist_ok=True)
+    args.results = results_folder(args.results, args.quick)
     return args
+
+
+def results_folder(given: Path | None, quick: bool) -> Path:
+    """The folder a script writes its CSV and PNG files into (made if missing): ``given``, else
+    ``benchmarks/results/`` for a full run and a new temporary folder for a ``--quick`` one, so that a smoke run
+    never overwrites measured results."""
+    if given is not None:
+        folder = given
+    else:
+        folder = Path(tempfile.mkdtemp(prefix="discsim-quick-")) if quick else DEFAULT_RESULTS
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
 
 
 def machine_summary() -> str:

@@ -248,6 +248,15 @@ def test_time_limit_interrupts_a_long_block():
     assert time.perf_counter() - start < 5.0
 
 
+def test_a_quick_run_writes_to_a_temporary_folder_unless_told_where(tmp_path):
+    """A smoke run never overwrites the measured results in benchmarks/results/."""
+    assert benchutils.parse_args("x", []).results == benchutils.DEFAULT_RESULTS
+    quick = benchutils.parse_args("x", ["--quick"]).results
+    assert quick.is_dir() and quick != benchutils.DEFAULT_RESULTS and benchutils.DEFAULT_RESULTS not in quick.parents
+    quick.rmdir()
+    assert benchutils.parse_args("x", ["--quick", "--results", str(tmp_path / "r")]).results == tmp_path / "r"
+
+
 def test_format_table_docstring_example():
     assert doctest.testmod(benchutils, raise_on_error=False).failed == 0
 

@@ -76,7 +76,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="a tiny run that proves the script works")
     parser.add_argument("--out", type=Path, help="CSV and PNG folder (default results/; --quick: a temporary one)")
     args = parser.parse_args(argv)
-    args.out = results_folder(args.out, args.quick)
     if shutil.which("valgrind") is None:
         print("valgrind is not installed (apt-get install valgrind); nothing measured", file=sys.stderr)
         return 1
@@ -102,8 +101,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 announce(f"  N={n:,} phi={packing}: new/base {row['ratio']:.4f}")
                 rows.append(row)
     print(format_table(rows, COLUMNS))
-    args.out.mkdir(parents=True, exist_ok=True)
-    write_csv(args.out / "ab_instructions.csv", rows, [*(c.key for c in COLUMNS), "base_label", "new_label"])
+    out = results_folder(args.out, args.quick)
+    write_csv(out / "ab_instructions.csv", rows, [*(c.key for c in COLUMNS), "base_label", "new_label"])
     return 0
 
 

@@ -220,7 +220,7 @@ def predict(
                 # The Python backend's time of impact, the same expressions (so the same bits). A candidate hits
                 # when it approaches (b < 0) and its path reaches contact (d > 0) or it touches (cc <= 0): about
                 # 6% of a 1:10 mixture's candidates, so one branch on that is well predicted and spares the rest
-                # the square root and the division (1.12x there, 1.05x for one size). The test is one min() of
+                # the square root and the division (1.12x there, 1.06x for one size). The test is one min() of
                 # floats: written with `and` or `&`, LLVM branches on b < 0 first, a coin toss (0.8x).
                 b = dx * dvx + dy * dvy
                 s = ri + rec[j, R]

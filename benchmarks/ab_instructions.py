@@ -56,7 +56,7 @@ def instructions(tree: Path, n: int, packing: float, collisions: int, scratch: P
         PYTHONHASHSEED="0",
         DISCSIM_NO_NUMBA="1",
     )
-    args = [str(tree), str(n), repr(packing), "1", str(warmup_collisions(n)), str(collisions)]
+    args = [str(tree), str(n), repr(packing), "1", str(warmup_collisions(n)), str(collisions), "python"]
     # Compile the bytecode first, outside the count, so that no counted run pays for it.
     subprocess.run([sys.executable, "-c", "import discsim"], cwd=workdir, env=env, check=True)
     command = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", sys.executable, "-c", _PROBE]

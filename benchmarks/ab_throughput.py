@@ -7,6 +7,7 @@ the commit before a refactor. Run::
     python benchmarks/ab_throughput.py --base PATH_TO_OTHER_CHECKOUT
     python benchmarks/ab_throughput.py --base PATH --sizes 1000 10000 --packings 0.3 --repeats 3 --collisions 200000
     python benchmarks/ab_throughput.py --base PATH --quick --out DIR     # seconds: proves the script runs
+    python benchmarks/ab_throughput.py --base PATH --backend numba       # the compiled loop instead
 
 The defaults (N = 10^3, 10^4, 10^5; packing fractions 0.3 and 0.7; 5 repeats of
 300,000 collisions) take about a quarter of an hour.
@@ -67,20 +68,20 @@ WARMUP_MAX = 20_000
 
 SIDES = ("base", "new")
 
-#: Run by :func:`measure` in a fresh interpreter; argv: tree, n, phi, seed, warm-up, timed collisions.
+#: Run by :func:`measure` in a fresh interpreter; argv: tree, n, phi, seed, warm-up, timed collisions, backend.
 #: Prints one JSON line. Public API only, so that it runs unchanged on both trees.
 _PROBE = """
 import gc, json, sys, time
 from pathlib import Path
 tree = Path(sys.argv[1]).resolve()
 n, phi, seed = int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
-warmup, collisions = int(sys.argv[5]), int(sys.argv[6])
+warmup, collisions, backend = int(sys.argv[5]), int(sys.argv[6]), sys.argv[7]
 import discsim
 where = Path(discsim.__file__).resolve()
 if not where.is_relative_to(tree):
     sys.exit(f"discsim was imported from {where}, not from the tree under test {tree}")
 discs, box = discsim.random_gas(n, phi, seed=seed)
-sim = discsim.EventDriven(discs, box, record=False)
+sim = discsim.EventDriven(discs, box, record=False, backend=backend)
 sim.run(events=warmup)
 gc.collect()
 before = sim.counts["collisions"]
@@ -98,7 +99,9 @@ def warmup_collisions(n: int) -> int:
     return min(WARMUP_MAX, WARMUP_PER_DISC * n)
 
 
-def measure(tree: Path, n: int, packing: float, seed: int, collisions: int, scratch: Path) -> dict:
+def measure(
+    tree: Path, n: int, packing: float, seed: int, collisions: int, scratch: Path, backend: str = "python"
+) -> dict:
     """One timed run of the tree ``tree`` in a fresh Python process.
 
     Args:
@@ -107,6 +110,8 @@ def measure(tree: Path, n: int, packing: float, seed: int, collisions: int, scra
         seed: seed of :func:`discsim.random_gas`.
         collisions: collisions in the timed segment.
         scratch: a temporary folder; the run's working folder and bytecode cache go under it.
+        backend: ``"python"`` (numba hidden) or ``"numba"`` (the compiled loop, from the tree's own cache of
+            machine code: the warm-up pays any compile, outside the timed segment).
 
     Returns:
         The probe's dict: ``discsim_file``, ``collisions`` (timed), ``seconds``, ``collisions_per_s``.
@@ -116,16 +121,12 @@ def measure(tree: Path, n: int, packing: float, seed: int, collisions: int, scra
     """
     workdir = scratch / "cwd"
     workdir.mkdir(exist_ok=True)
-    # DISCSIM_NO_NUMBA: trees with a compiled backend run their pure-Python loop, which is what is compared
-    # (older trees ignore the variable).
-    env = dict(
-        os.environ,
-        PYTHONPATH=str(tree),
-        PYTHONPYCACHEPREFIX=str(scratch / "pycache"),
-        PYTHONHASHSEED="0",
-        DISCSIM_NO_NUMBA="1",
-    )
-    args = [str(tree), str(n), repr(packing), str(seed), str(warmup_collisions(n)), str(collisions)]
+    # DISCSIM_NO_NUMBA: with backend "python", trees with a compiled backend run their pure-Python loop.
+    env = dict(os.environ, PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(scratch / "pycache"), PYTHONHASHSEED="0")
+    env.pop("DISCSIM_NO_NUMBA", None)
+    if backend == "python":
+        env["DISCSIM_NO_NUMBA"] = "1"
+    args = [str(tree), str(n), repr(packing), str(seed), str(warmup_collisions(n)), str(collisions), backend]
     done = subprocess.run(
         [sys.executable, "-c", _PROBE, *args], cwd=workdir, env=env, capture_output=True, text=True, check=False
     )
@@ -183,7 +184,7 @@ COLUMNS = [
     Column("ratio_min", "min", ".3f"),
     Column("ratio_max", "max", ".3f"),
 ]
-CSV_KEYS = [c.key for c in COLUMNS] + ["base_label", "new_label"]
+CSV_KEYS = [c.key for c in COLUMNS] + ["base_label", "new_label", "backend"]
 
 
 def run_pairs(base: Path, options: dict, scratch: Path) -> list[dict]:
@@ -196,7 +197,7 @@ def run_pairs(base: Path, options: dict, scratch: Path) -> list[dict]:
         for n, phi in points:
             rates = {}
             for side in order:
-                result = measure(trees[side], n, phi, repeat, options["collisions"], scratch)
+                result = measure(trees[side], n, phi, repeat, options["collisions"], scratch, options["backend"])
                 rates[side] = result["collisions_per_s"]
             ratio = rates["new"] / rates["base"]
             announce(
@@ -255,6 +256,9 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--collisions", type=int, help=f"timed collisions per run (default {FULL['collisions']:,})")
     parser.add_argument("--quick", action="store_true", help=f"{QUICK}: proves the script runs")
     parser.add_argument("--out", type=Path, help="CSV and PNG folder (default results/; --quick: a temporary one)")
+    parser.add_argument(
+        "--backend", choices=("python", "numba"), default="python", help="the event loop compared (default python)"
+    )
     args = parser.parse_args(argv)
     defaults = QUICK if args.quick else FULL
     for key, value in defaults.items():
@@ -275,8 +279,8 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run every pair, print the table, write ``ab_throughput.csv`` and ``ab_throughput.png``; return the exit code."""
     args = parse_args(argv)
-    options = {key: getattr(args, key) for key in FULL}
-    labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE)}
+    options = {key: getattr(args, key) for key in (*FULL, "backend")}
+    labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE), "backend": args.backend}
     print(f"discsim A/B throughput; {machine_summary()}")
     print(f"base: {args.base} ({labels['base_label']}); new: {NEW_TREE} ({labels['new_label']})")
     if args.base == NEW_TREE:
@@ -290,9 +294,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     for row in rows:
         row.update(labels)
     print(format_table(rows, COLUMNS))
-    csv_path = write_csv(args.out / "ab_throughput.csv", rows, CSV_KEYS)
-    title = f"discsim EventDriven: {labels['new_label']} / {labels['base_label']}"
-    png = plot(rows, args.out / "ab_throughput.png", title)
+    stem = "ab_throughput" if args.backend == "python" else f"ab_throughput_{args.backend}"
+    csv_path = write_csv(args.out / f"{stem}.csv", rows, CSV_KEYS)
+    title = f"discsim EventDriven ({args.backend}): {labels['new_label']} / {labels['base_label']}"
+    png = plot(rows, args.out / f"{stem}.png", title)
     print(f"wrote {csv_path}, {png}")
     return 0
 

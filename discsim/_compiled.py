@@ -1,4 +1,5 @@
-"""Building blocks of the compiled loops: the ``jit`` they share, ``prefetch``, and the compiled segment kernels.
+"""Building blocks of the compiled loops: the ``jit`` and ``inline`` they share, ``prefetch``, and
+:func:`compile_from_source`, which compiles plain Python functions (the physics parts) from their very source.
 
 Imported only by compiled modules (``engines/*/numba/``), which are imported when a ``backend="numba"`` engine
 is built. Without numba (or with ``DISCSIM_NO_NUMBA=1``) it still imports: ``jit`` returns the plain function
@@ -7,12 +8,11 @@ and ``prefetch`` does nothing, so that doctest collection and the pure-Python pa
 
 from __future__ import annotations
 
-import math
+from types import FunctionType
 
-from discsim import kernels
 from discsim._numba import numba
 
-__all__ = ["inline", "jit", "prefetch", "reflect_off_segment", "segment_time_of_impact", "time_of_impact"]
+__all__ = ["compile_from_source", "inline", "jit", "prefetch"]
 
 _nb = numba()
 if _nb is None:
@@ -59,45 +59,31 @@ else:
         return types.void(array, offset), codegen
 
 
-INF = math.inf
+def compile_from_source(functions, decorate):
+    """Compile plain Python functions with ``decorate`` (``jit`` or ``inline``), from their very source.
 
-#: :func:`discsim.kernels.time_of_impact`, compiled (the one definition of the time of impact).
-time_of_impact = jit(kernels.time_of_impact)
+    Each function is rebuilt over a copy of its own module's globals in which every function compiled before it
+    (matched by identity, not by name) is replaced by its compiled version, so that a compiled function calls
+    compiled callees. Pass callees before their callers.
 
+    Args:
+        functions: plain Python functions, callees first.
+        decorate: what compiles one function (``jit``, ``inline``, or numba's ``njit`` with options).
 
-@jit
-def segment_time_of_impact(px, py, vx, vy, radius, ax, ay, bx, by):
-    """:func:`discsim.kernels.segment_time_of_impact`, compiled (the same float operations in the same order)."""
-    ex, ey = bx - ax, by - ay
-    length2 = ex * ex + ey * ey
-    best = INF
-    length = math.sqrt(length2)
-    nx, ny = -ey / length, ex / length
-    s = (px - ax) * nx + (py - ay) * ny
-    vn = vx * nx + vy * ny
-    if s < 0.0:
-        s, vn = -s, -vn
-    if vn < 0.0:
-        t = (s - radius) / -vn if s > radius else 0.0
-        u = ((px + vx * t - ax) * ex + (py + vy * t - ay) * ey) / length2
-        if 0.0 <= u <= 1.0:
-            best = t
-    t = time_of_impact(ax - px, ay - py, -vx, -vy, radius)
-    if t < best:
-        best = t
-    t = time_of_impact(bx - px, by - py, -vx, -vy, radius)
-    if t < best:
-        best = t
-    return best
-
-
-@jit
-def reflect_off_segment(px, py, vx, vy, ax, ay, bx, by):
-    """:func:`discsim.kernels.reflect_off_segment`, compiled."""
-    ex, ey = bx - ax, by - ay
-    u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
-    u = min(max(u, 0.0), 1.0)
-    qx, qy = ax + u * ex, ay + u * ey
-    nx, ny = px - qx, py - qy
-    k = 2.0 * (vx * nx + vy * ny) / (nx * nx + ny * ny)
-    return vx - k * nx, vy - k * ny
+    Returns:
+        A dict from each given function to its compiled version (to itself without numba).
+    """
+    if _nb is None:
+        return {function: function for function in functions}
+    compiled: dict = {}
+    for function in functions:
+        table = dict(function.__globals__)
+        for name, value in table.items():
+            if isinstance(value, FunctionType) and value in compiled:
+                table[name] = compiled[value]
+        rebuilt = FunctionType(function.__code__, table, function.__name__, function.__defaults__, function.__closure__)
+        rebuilt.__qualname__ = function.__qualname__
+        rebuilt.__module__ = function.__module__
+        rebuilt.__doc__ = function.__doc__
+        compiled[function] = decorate(rebuilt)
+    return compiled

@@ -23,6 +23,7 @@ __all__ = [
     "Discs",
     "Segment",
     "kinetic_energy",
+    "minimum_image_1d",
     "momentum",
     "normalize_pass_through",
     "polygon",
@@ -324,12 +325,25 @@ class Box:
         """Displacements ``d`` ``(..., 2)`` mapped to their nearest periodic image (unchanged with walls).
 
         The one minimum-image rule: ``d - size * round(d / size)``, element by
-        element. The scalar hot loops inline the same formula.
+        element (:func:`minimum_image_1d` is the same rule on one float, for the loops).
         """
         if not self.periodic:
             return d
         size = self.size
         return d - size * np.round(d / size)
+
+
+def minimum_image_1d(d: float, length: float) -> float:
+    """One coordinate ``d`` of a displacement mapped to its nearest periodic image in a box ``length`` wide.
+
+    :meth:`Box.minimum_image` on one float, for the loops (numba compiles this very function into the compiled
+    ones): ``round`` rounds halves to even, as ``numpy.round`` does.
+
+    Example:
+        >>> minimum_image_1d(9.0, 10.0), minimum_image_1d(-6.0, 10.0)
+        (-1.0, 4.0)
+    """
+    return d - length * round(d / length)
 
 
 class Segment:

@@ -10,8 +10,9 @@ from paths import PACKAGE
 
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
-    "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled"],
+    "ground": ["model", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled"],
     "model": ["scene", "scenarios", "events", "trajectory", "cells", "repair"],
+    "physics": ["physics", "kernels"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "view", "__init__", "__main__"],
 }

@@ -29,12 +29,26 @@ import math
 
 import numpy as np
 
-from discsim._compiled import inline, jit, prefetch, reflect_off_segment, segment_time_of_impact
+from discsim._compiled import inline, jit, prefetch
+from discsim.events import EventKind
+from discsim.physics.compiled import (
+    advance,
+    cross,
+    pair_predict,
+    pair_resolve,
+    predict_x,
+    predict_y,
+    reflect,
+    reflect_off_segment,
+    segment_time_of_impact,
+)
+from discsim.physics.sources.boundaries import MINUS_X, MINUS_Y, PLUS_X, PLUS_Y
 from discsim.queue import sift_down, sift_up
 
 INF = math.inf
-COLLISION, WALL, CROSSING, SEGMENT = 0, 1, 2, 3
-PLUS_X, MINUS_X, PLUS_Y, MINUS_Y = 0, 1, 2, 3
+COLLISION, WALL, CROSSING, SEGMENT = (
+    int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT)
+)
 # Columns of a disc's row in ``rec``.
 X, Y, VX, VY, T, R, M, KEPT = 0, 1, 2, 3, 4, 5, 6, 7
 # Slots of ``ints``.
@@ -156,14 +170,8 @@ def predict(
     ints[I_PRED] += 1
     width = edges[nx]
     height = edges[nx + 1 + ny]
-    xi = rec[i, X]
-    yi = rec[i, Y]
-    vxi = rec[i, VX]
-    vyi = rec[i, VY]
     ri = rec[i, R]
-    dti = t - rec[i, T]
-    xi += vxi * dti
-    yi += vyi * dti
+    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
     c = cell[i]
     cx = c // ny
     cy = c - cx * ny
@@ -210,28 +218,12 @@ def predict(
                 if j == i or j == exclude or (filtering and blocked[gi, group[j]]):
                     j = nxt[j]
                     continue
-                vxj = rec[j, VX]
-                vyj = rec[j, VY]
-                dvx = vxj - vxi
-                dvy = vyj - vyi
-                dtj = t - rec[j, T]
-                dx = rec[j, X] + vxj * dtj + offx
-                dy = rec[j, Y] + vyj * dtj + offy
-                # The Python backend's time of impact, the same expressions (so the same bits). A candidate hits
-                # when it approaches (b < 0) and its path reaches contact (d > 0) or it touches (cc <= 0): about
-                # 6% of a 1:10 mixture's candidates, so one branch on that is well predicted and spares the rest
-                # the square root and the division (1.12x there, 1.06x for one size). The test is one min() of
-                # floats: written with `and` or `&`, LLVM branches on b < 0 first, a coin toss (0.8x).
-                b = dx * dvx + dy * dvy
-                s = ri + rec[j, R]
-                cc = dx * dx + dy * dy - s * s
-                a = dvx * dvx + dvy * dvy
-                d = b * b - a * cc
-                if min(-b, d if cc > 0.0 else 1.0) > 0.0:
-                    tij = 0.0 if cc <= 0.0 else cc / (-b + math.sqrt(d))
-                    if tij < best:
-                        best = tij
-                        new_partner = j
+                tij = pair_predict(
+                    rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], rec[j, R], offx, offy, vxi, vyi, ri
+                )
+                if tij < best:
+                    best = tij
+                    new_partner = j
                 j = nxt[j]
     if after_crossing:
         t_hit = rec[i, KEPT]
@@ -249,41 +241,15 @@ def predict(
         if partner >= 0:
             kept_stamp[i] = count[partner]
     # 2. The next wall, segment or cell boundary.
-    best = INF
-    kind = CROSSING
-    other = 0
-    if vxi > 0.0:
-        if not periodic and cx == nx - 1:
-            best = (width - ri - xi) / vxi
-            kind = WALL
-        else:
-            best = (edges[cx + 1] - xi) / vxi
-            other = PLUS_X
-    elif vxi < 0.0:
-        if not periodic and cx == 0:
-            best = (ri - xi) / vxi
-            kind = WALL
-        else:
-            best = (edges[cx] - xi) / vxi
-            other = MINUS_X
-    if vyi > 0.0:
-        if not periodic and cy == ny - 1:
-            ty = (height - ri - yi) / vyi
-            if ty < best:
-                best, kind, other = ty, WALL, 1
-        else:
-            ty = (edges[nx + 2 + cy] - yi) / vyi
-            if ty < best:
-                best, kind, other = ty, CROSSING, PLUS_Y
-    elif vyi < 0.0:
-        if not periodic and cy == 0:
-            ty = (ri - yi) / vyi
-            if ty < best:
-                best, kind, other = ty, WALL, 1
-        else:
-            ty = (edges[nx + 1 + cy] - yi) / vyi
-            if ty < best:
-                best, kind, other = ty, CROSSING, MINUS_Y
+    walled = not periodic
+    best, kind, other = predict_x(
+        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1
+    )
+    ty, kind_y, other_y = predict_y(
+        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1
+    )
+    if ty < best:
+        best, kind, other = ty, kind_y, other_y
     for m in range(seg_start[c], seg_start[c + 1]):
         k = seg_idx[m]
         if k != -2 - exclude:  # not the segment just left
@@ -426,22 +392,6 @@ def _prefetch_disc(c, rec, count, kept_partner, kept_stamp, cell, qt, qk, qo, qs
     prefetch(qs, c)
 
 
-@jit
-def _next_cell(c, direction, nx, ny):
-    """The cell next to ``c`` in ``direction`` (``PLUS_X`` ...), across a periodic edge too."""
-    cx = c // ny
-    cy = c - cx * ny
-    if direction == PLUS_X:
-        cx = cx + 1 if cx + 1 < nx else 0
-    elif direction == MINUS_X:
-        cx = cx - 1 if cx > 0 else nx - 1
-    elif direction == PLUS_Y:
-        cy = cy + 1 if cy + 1 < ny else 0
-    else:
-        cy = cy - 1 if cy > 0 else ny - 1
-    return cx * ny + cy
-
-
 @inline
 def _prefetch_cells(c, head, nx, ny):
     """Start fetching the heads of the 3 x 3 cells around cell ``c`` (three runs of three in memory)."""
@@ -526,7 +476,8 @@ def run_events(
             _prefetch_disc(other, rec, count, kept_partner, kept_stamp, cell, qt, qk, qo, qs)
         c = cell[i]
         if kind == CROSSING:  # the cells around the one it enters
-            c = _next_cell(c, other, nx, ny)
+            cx, cy, _, _ = cross(c // ny, c - (c // ny) * ny, other, nx, ny)
+            c = cx * ny + cy
         _prefetch_cells(c, head, nx, ny)
         # The event stays at the top of the heap: predicting i again, as every branch below does,
         # replaces it (see push).
@@ -541,40 +492,15 @@ def run_events(
                     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
                 )  # fmt: skip
                 continue
-            vxi = rec[i, VX]
-            vyi = rec[i, VY]
-            ri = rec[i, R]
-            dt = t - rec[i, T]
-            xi = rec[i, X] + vxi * dt
-            yi = rec[i, Y] + vyi * dt
-            vxj = rec[j, VX]
-            vyj = rec[j, VY]
-            rj = rec[j, R]
-            dt = t - rec[j, T]
-            xj = rec[j, X] + vxj * dt
-            yj = rec[j, Y] + vyj * dt
-            dx, dy = xj - xi, yj - yi
-            if periodic:
-                dx -= width * np.rint(dx / width)
-                dy -= height * np.rint(dy / height)
-            overlap = 1.0 - math.sqrt(dx * dx + dy * dy) / (ri + rj)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
+            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T])
+            mi, mj = rec[i, M], rec[j, M]
+            dx, dy, uxi, uyi, uxj, uyj = pair_resolve(
+                xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic
+            )
+            overlap = 1.0 - math.sqrt(dx * dx + dy * dy) / (rec[i, R] + rec[j, R])
             if overlap > max_overlap:
                 max_overlap = overlap
-            mi, mj = rec[i, M], rec[j, M]
-            # The elastic response, as discsim.kernels.resolve_collision.
-            d2 = dx * dx + dy * dy
-            bb = (vxj - vxi) * dx + (vyj - vyi) * dy
-            if mi == INF:
-                f1, f2 = 0.0, 2.0
-            elif mj == INF:
-                f1, f2 = 2.0, 0.0
-            else:
-                f1, f2 = 2.0 * mj / (mi + mj), 2.0 * mi / (mi + mj)
-            k = bb / d2
-            uxi = vxi + f1 * k * dx
-            uyi = vyi + f1 * k * dy
-            uxj = vxj - f2 * k * dx
-            uyj = vyj - f2 * k * dy
             rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, uxi, uyi, t
             rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], rec[j, T] = xj, yj, uxj, uyj, t
             _prefetch_cells(cell[j], head, nx, ny)
@@ -608,21 +534,14 @@ def run_events(
                     max_queue = ints[I_SIZE]
             last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j
         elif kind == WALL or kind == SEGMENT:
-            vxi = rec[i, VX]
-            vyi = rec[i, VY]
-            dt = t - rec[i, T]
-            xi = rec[i, X] + vxi * dt
-            yi = rec[i, Y] + vyi * dt
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
             if kind == SEGMENT:
                 vxi, vyi = reflect_off_segment(
                     xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
                 )
                 exclude = -2 - other  # never the same segment again straight away
             else:
-                if other == 0:
-                    vxi = -vxi
-                else:
-                    vyi = -vyi
+                vxi, vyi = reflect(vxi, vyi, other)
                 exclude = -1
             rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, vxi, vyi, t
             count[i] += 1
@@ -646,32 +565,13 @@ def run_events(
         else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
             c = cell[i]
             _leave(i, c, head, nxt)
-            cx = c // ny
-            cy = c - cx * ny
-            if other == PLUS_X:
-                cx += 1
-                if cx == nx:
-                    cx = 0
-                    rec[i, X] = rec[i, X] - width
-                    images[i, 0] += 1
-            elif other == MINUS_X:
-                cx -= 1
-                if cx < 0:
-                    cx = nx - 1
-                    rec[i, X] = rec[i, X] + width
-                    images[i, 0] -= 1
-            elif other == PLUS_Y:
-                cy += 1
-                if cy == ny:
-                    cy = 0
-                    rec[i, Y] = rec[i, Y] - height
-                    images[i, 1] += 1
-            else:
-                cy -= 1
-                if cy < 0:
-                    cy = ny - 1
-                    rec[i, Y] = rec[i, Y] + height
-                    images[i, 1] -= 1
+            cx, cy, wrap_x, wrap_y = cross(c // ny, c - (c // ny) * ny, other, nx, ny)
+            if wrap_x != 0:  # out through one edge of the box, in through the other
+                rec[i, X] = rec[i, X] - wrap_x * width
+                images[i, 0] += wrap_x
+            elif wrap_y != 0:
+                rec[i, Y] = rec[i, Y] - wrap_y * height
+                images[i, 1] += wrap_y
             c = cx * ny + cy
             cell[i] = c
             _enter(i, c, head, nxt)

@@ -32,7 +32,8 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numbering import TILE, fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EventKind, EventLog
-from discsim.kernels import reflect_off_segment, resolve_collision, segment_time_of_impact
+from discsim.physics.laws import reflect
+from discsim.physics.sources import boundaries, pairs, segments
 from discsim.queue import CalendarEventQueue, EventQueue, HeapEventQueue
 from discsim.scene import Scene
 
@@ -56,8 +57,8 @@ _COLLISION, _WALL, _CROSSING, _SEGMENT = (
 )
 # Physical events between moves of the internal clock's epoch (at least 16 per disc).
 _REBASE_EVENTS = 1 << 18
-# Directions of a cell crossing.
-_PLUS_X, _MINUS_X, _PLUS_Y, _MINUS_Y = 0, 1, 2, 3
+# Directions of a cell crossing (one numbering: discsim.physics.sources.boundaries).
+_PLUS_X, _MINUS_X, _PLUS_Y, _MINUS_Y = boundaries.PLUS_X, boundaries.MINUS_X, boundaries.PLUS_Y, boundaries.MINUS_Y
 
 #: The event queues, by name; all give the same events bit for bit.
 QUEUES = {"calendar": CalendarEventQueue, "sorted": EventQueue, "heap": HeapEventQueue}
@@ -373,7 +374,11 @@ class PythonBackend:
           changed course since (else the full scan runs).
         - ``predictions()`` counts the predictions made (from ``n_pred``).
 
-        The neighbour loop inlines :func:`discsim.kernels.time_of_impact`.
+        The neighbour loop and the wall and cell-edge times inline the law of motion's parts
+        (:func:`discsim.physics.sources.pairs.predict`, :func:`discsim.physics.sources.boundaries.predict_x`
+        and ``predict_y``), the only copies left: a Python call per candidate or per axis would cost this
+        loop more than its speed budget allows. The compiled loop calls the parts themselves, and the
+        cross-backend tests hold the two to the same events bit for bit.
         Also builds the tiles of cell members from ``cells`` (the discs of each
         cell, in order), the static per-cell records (``_cell_info``), and points
         each disc at its cell's record (``_where``, from its cell index in ``cell``).
@@ -418,6 +423,7 @@ class PythonBackend:
         group = self.scene.group[self._order].tolist()
         blocked = self.scene.blocked.tolist()
         sqrt = math.sqrt
+        predict_segment = segments.predict
         # The payloads of wall, crossing and segment events, made once and shared:
         # ``payloads[kind][other]``. A pop then reads no freshly scattered tuple for them.
         payloads = [
@@ -516,7 +522,7 @@ class PythonBackend:
                         best, kind, other = ty, _CROSSING, _MINUS_Y
             for k in segs:
                 if k != -2 - exclude:  # not the segment just left
-                    ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, *segment_ends[k])
+                    ts = predict_segment(xi, yi, vxi, vyi, ri, *segment_ends[k])
                     if ts < best:
                         best, kind, other = ts, _SEGMENT, k
             if best < 0.0:
@@ -554,6 +560,7 @@ class PythonBackend:
         caller = self._caller_id  # the caller's numbering, for the log
         counts = self._counts
         segment_ends = [(*seg.p0.tolist(), *seg.p1.tolist()) for seg in self.segments]
+        resolve_pair, resolve_segment, cross = pairs.resolve, segments.resolve, boundaries.cross
         n_coll = n_wall = n_cross = n_stale = 0
         done = 0
         max_queue = self.max_queue
@@ -585,18 +592,16 @@ class PythonBackend:
                 dt = t - tj
                 xj += vxj * dt
                 yj += vyj * dt
-                dx, dy = xj - xi, yj - yi
-                if periodic:
-                    dx -= width * round(dx / width)
-                    dy -= height * round(dy / height)
-                overlap = 1.0 - sqrt(dx * dx + dy * dy) / (ri + rj)
-                if overlap > max_overlap:
-                    max_overlap = overlap
                 if one_mass is None:
                     mi, mj = mass[i], mass[j]
                 else:
                     mi = mj = one_mass
-                uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+                dx, dy, uxi, uyi, uxj, uyj = resolve_pair(
+                    xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic
+                )
+                overlap = 1.0 - sqrt(dx * dx + dy * dy) / (ri + rj)
+                if overlap > max_overlap:
+                    max_overlap = overlap
                 pack(disc, i * _RECORD_BYTES, xi, yi, uxi, uyi, t, ri)
                 pack(disc, j * _RECORD_BYTES, xj, yj, uxj, uyj, t, rj)
                 virial -= mi * ((uxi - vxi) * dx + (uyi - vyi) * dy)  # owners are never obstacles
@@ -620,10 +625,7 @@ class PythonBackend:
                 dt = t - ti
                 xi += vxi * dt
                 yi += vyi * dt
-                if other == 0:
-                    vxi = -vxi
-                else:
-                    vyi = -vyi
+                vxi, vyi = reflect(vxi, vyi, other)
                 pack(disc, i * _RECORD_BYTES, xi, yi, vxi, vyi, t, ri)
                 count[i] += 1
                 n_wall += 1
@@ -637,7 +639,7 @@ class PythonBackend:
                 dt = t - ti
                 xi += vxi * dt
                 yi += vyi * dt
-                vxi, vyi = reflect_off_segment(xi, yi, vxi, vyi, *segment_ends[other])
+                vxi, vyi = resolve_segment(xi, yi, vxi, vyi, *segment_ends[other])
                 pack(disc, i * _RECORD_BYTES, xi, yi, vxi, vyi, t, ri)
                 count[i] += 1
                 n_wall += 1
@@ -659,34 +661,12 @@ class PythonBackend:
                 for tile, slot in here[_GHOSTS]:  # the copies in the rings of neighbouring tiles
                     tile[slot] = others
                 cx, cy = divmod(here[_CELL_INDEX], ny)
-                if other == _PLUS_X:
-                    cx += 1
-                    if cx == nx:
-                        cx = 0
-                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
-                        pack(disc, i * _RECORD_BYTES, xi - width, yi, vxi, vyi, ti, ri)
-                        image_x[i] += 1
-                elif other == _MINUS_X:
-                    cx -= 1
-                    if cx < 0:
-                        cx = nx - 1
-                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
-                        pack(disc, i * _RECORD_BYTES, xi + width, yi, vxi, vyi, ti, ri)
-                        image_x[i] -= 1
-                elif other == _PLUS_Y:
-                    cy += 1
-                    if cy == ny:
-                        cy = 0
-                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
-                        pack(disc, i * _RECORD_BYTES, xi, yi - height, vxi, vyi, ti, ri)
-                        image_y[i] += 1
-                else:
-                    cy -= 1
-                    if cy < 0:
-                        cy = ny - 1
-                        xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
-                        pack(disc, i * _RECORD_BYTES, xi, yi + height, vxi, vyi, ti, ri)
-                        image_y[i] -= 1
+                cx, cy, wrap_x, wrap_y = cross(cx, cy, other, nx, ny)
+                if wrap_x or wrap_y:  # out through one edge of the box, in through the other
+                    xi, yi, vxi, vyi, ti, ri = unpack(disc, i * _RECORD_BYTES)
+                    pack(disc, i * _RECORD_BYTES, xi - wrap_x * width, yi - wrap_y * height, vxi, vyi, ti, ri)
+                    image_x[i] += wrap_x
+                    image_y[i] += wrap_y
                 here = where[i] = info[cx * ny + cy]
                 tile, slot = here[1], here[_SLOT]
                 others = tile[slot] + (i,)

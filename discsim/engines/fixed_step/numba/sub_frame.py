@@ -30,9 +30,6 @@ import math
 
 import numpy as np
 
-from discsim import kernels
-from discsim._compiled import segment_time_of_impact as _segment_time_of_impact
-from discsim._compiled import time_of_impact as _time_of_impact
 from discsim._numba import numba
 from discsim.engines.fixed_step.numba.kernels import (
     _cells,
@@ -48,6 +45,9 @@ from discsim.engines.fixed_step.numba.kernels import (
     cpython_hypot,
     jit,
 )
+from discsim.physics.compiled import pair_time_of_impact as _time_of_impact
+from discsim.physics.compiled import segment_time_of_impact as _segment_time_of_impact
+from discsim.physics.compiled import wall_time as _wall_time
 
 _nb = numba()
 if _nb is None:  # pragma: no cover - importable without numba (doctests); the engine needs numba to use it
@@ -72,8 +72,6 @@ DONE, JAMMED = 0, 1
 #: A frame with more responses than this, plus this many per disc, is jammed (``SubFrame.MAX_RESPONSES``).
 MAX_RESPONSES = 1000
 MAX_RESPONSES_PER_DISC = 50
-
-_wall_time = leaf(kernels.wall_time)
 
 
 # --- scalar kernels ----------------------------------------------------------------------------------------

@@ -11,6 +11,7 @@ import numpy as np
 
 from discsim.errors import TimeError
 from discsim.events import added_discs
+from discsim.physics.dynamics import advance
 
 __all__ = ["check_times", "log_start", "positions_from_log", "reconstruct"]
 
@@ -109,7 +110,8 @@ def reconstruct(
         k = lo + np.searchsorted(t_rec[lo:hi], times, side="right") - 1
         k = np.maximum(k, lo)
         dt = (times - t_rec[k])[:, None]
-        out[:, d, :] = state[k, :2] + state[k, 2:] * dt
+        x, y, _, _ = advance(state[k, 0], state[k, 1], state[k, 2], state[k, 3], dt[:, 0])
+        out[:, d, 0], out[:, d, 1] = x, y
     if periodic and not unwrapped:
         out = box.wrap(out)
     return out
@@ -121,7 +123,8 @@ def _image_shifts(disc, t_rec, state, starts, size) -> np.ndarray:
     Records are sorted by disc, then time. Between two records of a disc it flies straight, so the
     later logged position differs from the earlier one's flight by whole box lengths plus roundoff.
     """
-    flown = state[:-1, :2] + state[:-1, 2:] * (t_rec[1:] - t_rec[:-1])[:, None]
+    x, y, _, _ = advance(state[:-1, 0], state[:-1, 1], state[:-1, 2], state[:-1, 3], t_rec[1:] - t_rec[:-1])
+    flown = np.column_stack([x, y])
     jump = np.nan_to_num(np.round((flown - state[1:, :2]) / size) * size)  # NaN: not there yet, or gone
     jump[np.isin(np.arange(1, len(state)), starts)] = 0.0  # the first record of the next disc
     shifts = np.zeros_like(state[:, :2])

@@ -11,8 +11,8 @@ from paths import PACKAGE
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
     "ground": ["model", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled"],
-    "model": ["scene", "scenarios", "events", "trajectory", "cells", "repair"],
-    "physics": ["physics", "kernels"],
+    "model": ["scene", "scenarios", "events", "cells", "repair"],
+    "physics": ["physics", "kernels", "trajectory"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "view", "__init__", "__main__"],
 }

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 
+from discsim.physics.dynamics import advance
 from discsim.queue import sift_down, sift_up  # the indexed heap (by (time, owner)) of the compiled loops
 
 INF = math.inf
@@ -177,9 +178,7 @@ def predict(i, t, x, y, vx, vy, tr, r0, count, cell, head, nxt, qk, qo, qs, par,
 
 
 def _advance(i, t, x, y, vx, vy, tr):
-    dt = t - tr[i]
-    x[i] += vx[i] * dt
-    y[i] += vy[i] * dt
+    x[i], y[i], vx[i], vy[i] = advance(x[i], y[i], vx[i], vy[i], t - tr[i])
     tr[i] = t
 
 
@@ -360,6 +359,7 @@ def run_epoch(x, y, vx, vy, tr, r0, m, count, cell, head, nxt, prv, heap, ht, hp
 
 #: The functions, callees before callers, in the order :mod:`.compiled` compiles them.
 ORDER = (
+    "advance",
     "growing_time_of_impact",
     "sift_up",
     "sift_down",

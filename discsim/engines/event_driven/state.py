@@ -12,6 +12,7 @@ import numpy as np
 
 from discsim.engines.base import EngineState
 from discsim.errors import CheckpointError
+from discsim.physics.dynamics import advance
 
 __all__ = ["EventDrivenState"]
 
@@ -178,4 +179,6 @@ class EventDrivenState(EngineState):
     def positions_at(self, time: float) -> np.ndarray:
         """``(N, 2)`` centres at ``time`` (absolute), not wrapped."""
         t = time - self.epoch
-        return self.ref_positions + self.velocities * (t - self.ref_times)[:, None]
+        (x0, y0), (vx, vy) = self.ref_positions.T, self.velocities.T
+        x, y, _, _ = advance(x0, y0, vx, vy, t - self.ref_times)
+        return np.column_stack([x, y]).reshape(-1, 2)

@@ -16,6 +16,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EVENT_DTYPE, EventKind, EventLog
+from discsim.physics.dynamics import advance
 from discsim.scene import Scene
 
 __all__ = ["NumbaBackend"]
@@ -320,7 +321,8 @@ class NumbaBackend:
         """``(N, 2)`` centres at ``time``, not wrapped."""
         t = self.time - float(self._floats[self._lp.F_EPOCH])
         rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
-        return np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)]).reshape(-1, 2)
+        x, y, _, _ = advance(rx, ry, vx, vy, t - tr)
+        return np.column_stack([x, y]).reshape(-1, 2)
 
     def unwrapped_positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, each disc followed across the periodic edges."""

@@ -32,6 +32,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numbering import TILE, fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EventKind, EventLog
+from discsim.physics.dynamics import advance
 from discsim.physics.laws import reflect
 from discsim.physics.sources import boundaries, pairs, segments
 from discsim.queue import CalendarEventQueue, EventQueue, HeapEventQueue
@@ -314,7 +315,8 @@ class PythonBackend:
         """``(N, 2)`` centres at ``time``, not wrapped."""
         t = self.time - self._epoch
         rx, ry, vx, vy, tr, _ = self._records().T
-        return np.column_stack([rx + vx * (t - tr), ry + vy * (t - tr)]).reshape(-1, 2)
+        x, y, _, _ = advance(rx, ry, vx, vy, t - tr)
+        return np.column_stack([x, y]).reshape(-1, 2)
 
     def unwrapped_positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, each disc followed across the periodic edges."""

@@ -15,6 +15,7 @@ from discsim.physics.sources import boundaries, pairs
 
 __all__ = [
     "advance",
+    "closest_point_on_segment",
     "collide",
     "cross",
     "exit_x",
@@ -61,6 +62,7 @@ segment_time_of_impact = _parts[dynamics.segment_time_of_impact]
 collide = _parts[laws.collide]
 reflect = _parts[laws.reflect]
 reflect_off_segment = _parts[laws.reflect_off_segment]
+closest_point_on_segment = _parts[laws.closest_point_on_segment]
 pair_predict = _parts[pairs.predict]
 pair_resolve = _parts[pairs.resolve]
 predict_x = _parts[boundaries.predict_x]

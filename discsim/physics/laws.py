@@ -70,7 +70,10 @@ def closest_point_on_segment(px: float, py: float, ax: float, ay: float, bx: flo
     """
     ex, ey = bx - ax, by - ay
     u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
-    u = min(max(u, 0.0), 1.0)
+    if 0.0 > u:  # min(max(u, 0.0), 1.0) as Python picks (-0.0 and NaN kept), also when numba compiles it
+        u = 0.0
+    if 1.0 < u:
+        u = 1.0
     return ax + u * ex, ay + u * ey
 
 

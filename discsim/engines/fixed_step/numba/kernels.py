@@ -24,6 +24,9 @@ import math
 import numpy as np
 
 from discsim._numba import numba
+from discsim.physics.compiled import closest_point_on_segment as _closest_point
+from discsim.physics.compiled import collide as _collide
+from discsim.physics.compiled import reflect_off_segment as _reflect
 
 _nb = numba()
 if _nb is None:  # pragma: no cover - the engine imports this module only when numba imports
@@ -140,27 +143,6 @@ def _image(d, size):
 
 
 @jit
-def _closest_point(px, py, ax, ay, bx, by):
-    """:func:`discsim.kernels.closest_point_on_segment`."""
-    ex, ey = bx - ax, by - ay
-    u = ((px - ax) * ex + (py - ay) * ey) / (ex * ex + ey * ey)
-    if 0.0 > u:  # min(max(u, 0.0), 1.0), as Python picks
-        u = 0.0
-    if 1.0 < u:
-        u = 1.0
-    return ax + u * ex, ay + u * ey
-
-
-@jit
-def _reflect(px, py, vx, vy, ax, ay, bx, by):
-    """:func:`discsim.kernels.reflect_off_segment`."""
-    qx, qy = _closest_point(px, py, ax, ay, bx, by)
-    nx, ny = px - qx, py - qy
-    k = 2.0 * (vx * nx + vy * ny) / (nx * nx + ny * ny)
-    return vx - k * nx, vy - k * ny
-
-
-@jit
 def _segment_distance(px, py, ax, ay, bx, by):
     """:func:`discsim.engines.fixed_step.frame.point_segment_distance` of one point and one segment."""
     ex, ey = bx - ax, by - ay
@@ -169,21 +151,6 @@ def _segment_distance(px, py, ax, ay, bx, by):
     u = (wx * ex + wy * ey) / ee if ee > 0.0 else 0.0
     u = min(max(u, 0.0), 1.0)
     return math.hypot(wx - u * ex, wy - u * ey)  # numpy's hypot: the C library's, as numba's
-
-
-@jit
-def _collide(dx, dy, v1x, v1y, v2x, v2y, m1, m2):
-    """:func:`discsim.kernels.resolve_collision`."""
-    d2 = dx * dx + dy * dy
-    b = (v2x - v1x) * dx + (v2y - v1y) * dy
-    if m1 == INF:
-        f1, f2 = 0.0, 2.0
-    elif m2 == INF:
-        f1, f2 = 2.0, 0.0
-    else:
-        f1, f2 = 2.0 * m2 / (m1 + m2), 2.0 * m1 / (m1 + m2)
-    k = b / d2
-    return v1x + f1 * k * dx, v1y + f1 * k * dy, v2x - f2 * k * dx, v2y - f2 * k * dy
 
 
 @jit

@@ -59,31 +59,41 @@ else:
         return types.void(array, offset), codegen
 
 
-def compile_from_source(functions, decorate):
+def compile_from_source(functions, decorate, replace=None):
     """Compile plain Python functions with ``decorate`` (``jit`` or ``inline``), from their very source.
 
     Each function is rebuilt over a copy of its own module's globals in which every function compiled before it
     (matched by identity, not by name) is replaced by its compiled version, so that a compiled function calls
     compiled callees. Pass callees before their callers.
 
+    ``replace`` swaps parts: ``{free_flight.advance: my_law.advance}`` compiles ``my_law.advance`` in the place
+    of ``free_flight.advance``, and every function that called the one now calls the other. That is how a loop
+    is compiled over another law of motion or collision law without an edit.
+
     Args:
         functions: plain Python functions, callees first.
         decorate: what compiles one function (``jit``, ``inline``, or numba's ``njit`` with options).
+        replace: a dict from listed functions to the functions that stand in for them (None: none).
 
     Returns:
-        A dict from each given function to its compiled version (to itself without numba).
+        A dict from each given function to its compiled version (to itself, or its replacement, without
+        numba: then nothing is compiled and the callers keep their own globals).
     """
+    replace = replace or {}
     if _nb is None:
-        return {function: function for function in functions}
+        return {function: replace.get(function, function) for function in functions}
     compiled: dict = {}
     for function in functions:
-        table = dict(function.__globals__)
+        source = replace.get(function, function)
+        table = dict(source.__globals__)
         for name, value in table.items():
-            if isinstance(value, FunctionType) and value in compiled:
-                table[name] = compiled[value]
-        rebuilt = FunctionType(function.__code__, table, function.__name__, function.__defaults__, function.__closure__)
-        rebuilt.__qualname__ = function.__qualname__
-        rebuilt.__module__ = function.__module__
-        rebuilt.__doc__ = function.__doc__
-        compiled[function] = decorate(rebuilt)
+            if isinstance(value, FunctionType):
+                value = replace.get(value, value)
+                if value in compiled:
+                    table[name] = compiled[value]
+        rebuilt = FunctionType(source.__code__, table, source.__name__, source.__defaults__, source.__closure__)
+        rebuilt.__qualname__ = source.__qualname__
+        rebuilt.__module__ = source.__module__
+        rebuilt.__doc__ = source.__doc__
+        compiled[function] = compiled[source] = decorate(rebuilt)
     return compiled

@@ -14,9 +14,12 @@ from discsim.physics import dynamics, laws
 from discsim.physics.sources import boundaries, pairs
 
 __all__ = [
+    "DYNAMICS",
+    "LAWS",
     "advance",
     "closest_point_on_segment",
     "collide",
+    "compile_parts",
     "cross",
     "exit_x",
     "exit_y",
@@ -32,40 +35,72 @@ __all__ = [
     "wall_time",
 ]
 
-_parts = compile_from_source(
-    [
-        model.minimum_image_1d,
-        dynamics.advance,
-        dynamics.exit_x,
-        dynamics.exit_y,
-        dynamics.pair_time_of_impact,
-        dynamics.segment_time_of_impact,
-        laws.collide,
-        laws.reflect,
-        laws.closest_point_on_segment,
-        laws.reflect_off_segment,
-        pairs.predict,
-        pairs.resolve,
-        boundaries.predict_x,
-        boundaries.predict_y,
-        boundaries.cross,
-        boundaries.wall_time,
-    ],
-    inline,
+#: The functions a law of motion defines (:mod:`discsim.physics.dynamics` is the model), and a collision law
+#: (:mod:`discsim.physics.laws`).
+DYNAMICS = ("advance", "exit_x", "exit_y", "pair_time_of_impact", "segment_time_of_impact")
+LAWS = ("collide", "reflect", "closest_point_on_segment", "reflect_off_segment")
+#: Every part, callees before callers.
+_SOURCES = (
+    model.minimum_image_1d,
+    *(getattr(dynamics, name) for name in DYNAMICS),
+    *(getattr(laws, name) for name in LAWS),
+    pairs.predict,
+    pairs.resolve,
+    boundaries.predict_x,
+    boundaries.predict_y,
+    boundaries.cross,
+    boundaries.wall_time,
 )
-minimum_image_1d = _parts[model.minimum_image_1d]
-advance = _parts[dynamics.advance]
-exit_x = _parts[dynamics.exit_x]
-exit_y = _parts[dynamics.exit_y]
-pair_time_of_impact = _parts[dynamics.pair_time_of_impact]
-segment_time_of_impact = _parts[dynamics.segment_time_of_impact]
-collide = _parts[laws.collide]
-reflect = _parts[laws.reflect]
-reflect_off_segment = _parts[laws.reflect_off_segment]
-closest_point_on_segment = _parts[laws.closest_point_on_segment]
-pair_predict = _parts[pairs.predict]
-pair_resolve = _parts[pairs.resolve]
-predict_x = _parts[boundaries.predict_x]
-predict_y = _parts[boundaries.predict_y]
-cross = _parts[boundaries.cross]
-wall_time = _parts[boundaries.wall_time]
+#: The names the compiled loops import, and the source of each.
+_NAMES = {
+    "minimum_image_1d": model.minimum_image_1d,
+    **{name: getattr(dynamics, name) for name in DYNAMICS},
+    **{name: getattr(laws, name) for name in LAWS},
+    "pair_predict": pairs.predict,
+    "pair_resolve": pairs.resolve,
+    "predict_x": boundaries.predict_x,
+    "predict_y": boundaries.predict_y,
+    "cross": boundaries.cross,
+    "wall_time": boundaries.wall_time,
+}
+
+
+def compile_parts(law_of_motion=None, collision_law=None) -> dict:
+    """Every part compiled (``inline``), over another law of motion or collision law if given.
+
+    Args:
+        law_of_motion: a module (or any object) with the functions :data:`DYNAMICS` names, with the
+            signatures of :mod:`discsim.physics.dynamics`; None: free flight.
+        collision_law: likewise with the functions :data:`LAWS` names (:mod:`discsim.physics.laws`); None:
+            elastic and frictionless.
+
+    Returns:
+        A dict from the names the compiled loops use (``advance``, ``pair_predict``, ``predict_x`` ...) to the
+        compiled parts.
+    """
+    replace = {}
+    if law_of_motion is not None:
+        replace.update({getattr(dynamics, name): getattr(law_of_motion, name) for name in DYNAMICS})
+    if collision_law is not None:
+        replace.update({getattr(laws, name): getattr(collision_law, name) for name in LAWS})
+    compiled = compile_from_source(_SOURCES, inline, replace)
+    return {name: compiled[source] for name, source in _NAMES.items()}
+
+
+_parts = compile_parts()
+minimum_image_1d = _parts["minimum_image_1d"]
+advance = _parts["advance"]
+exit_x = _parts["exit_x"]
+exit_y = _parts["exit_y"]
+pair_time_of_impact = _parts["pair_time_of_impact"]
+segment_time_of_impact = _parts["segment_time_of_impact"]
+collide = _parts["collide"]
+reflect = _parts["reflect"]
+closest_point_on_segment = _parts["closest_point_on_segment"]
+reflect_off_segment = _parts["reflect_off_segment"]
+pair_predict = _parts["pair_predict"]
+pair_resolve = _parts["pair_resolve"]
+predict_x = _parts["predict_x"]
+predict_y = _parts["predict_y"]
+cross = _parts["cross"]
+wall_time = _parts["wall_time"]

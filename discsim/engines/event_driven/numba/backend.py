@@ -9,6 +9,8 @@ most ``BUDGET`` queue pops, so Ctrl-C is seen within milliseconds and lands betw
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from discsim._interrupt import deferred_interrupt
@@ -16,7 +18,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EVENT_DTYPE, EventKind, EventLog
-from discsim.physics.dynamics import advance
+from discsim.physics import dynamics
 from discsim.scene import Scene
 
 __all__ = ["NumbaBackend"]
@@ -47,17 +49,24 @@ class NumbaBackend:
         queue: the queue the caller asked for; this backend always uses its array-based queue (each disc's
             pending time and a binary heap of blocks of discs), which pops events in the same ``(time, disc)``
             order as every Python queue.
+        law_of_motion, collision_law: other physics for the loop (modules with the functions of
+            :mod:`discsim.physics.dynamics` and :mod:`discsim.physics.laws`; None: free flight and the elastic
+            law), compiled into it by :func:`~discsim.engines.event_driven.numba.loop.with_physics`. No engine
+            passes them yet: ``docs/adding-physics.md`` shows a test that does.
     """
 
     name = "numba"
 
-    def __init__(self, scene: Scene, grid: CellGrid, queue: str):
+    def __init__(self, scene: Scene, grid: CellGrid, queue: str, law_of_motion=None, collision_law=None):
         self.scene = scene
         self.box = scene.box
         self.grid = grid
         self.queue_kind = queue
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
         self._lp = _loop()
+        self._law_of_motion = law_of_motion or dynamics
+        if law_of_motion is not None or collision_law is not None:
+            self._lp = SimpleNamespace(**self._lp.with_physics(law_of_motion, collision_law))
         box = self.box
         nx, ny = grid.nx, grid.ny
         # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides
@@ -321,7 +330,7 @@ class NumbaBackend:
         """``(N, 2)`` centres at ``time``, not wrapped."""
         t = self.time - float(self._floats[self._lp.F_EPOCH])
         rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
-        x, y, _, _ = advance(rx, ry, vx, vy, t - tr)
+        x, y, _, _ = self._law_of_motion.advance(rx, ry, vx, vy, t - tr)
         return np.column_stack([x, y]).reshape(-1, 2)
 
     def unwrapped_positions(self) -> np.ndarray:

@@ -608,3 +608,48 @@ def run_events(
     ints[I_CROSS] += n_cross
     ints[I_STALE] += n_stale
     return done, n_cross, logged, why
+
+
+# --- the loop over other physics -----------------------------------------------------------------------
+#: The functions above that call the physics parts (directly or through ``predict``), callees first: the ones
+#: :func:`with_physics` compiles anew.
+PHYSICAL = ("predict", "predict_all", "set_disc", "run_events")
+
+
+def with_physics(law_of_motion=None, collision_law=None) -> dict:
+    """This loop compiled over another law of motion or collision law: nothing above is edited.
+
+    The parts (:func:`discsim.physics.compiled.compile_parts`) are compiled over the given laws, and the
+    functions of :data:`PHYSICAL` are compiled anew from their very source with those parts in place of free
+    flight and the elastic law; the rest (queue, cells, prefetches) is shared. The new functions are compiled
+    in this process, not cached on disk (the cache knows a function by its own source file only, not by the
+    laws it was compiled over), which takes about as long as the first compile of this module.
+
+    Args:
+        law_of_motion: a module with the functions of :data:`discsim.physics.compiled.DYNAMICS` (None: free
+            flight).
+        collision_law: a module with those of :data:`discsim.physics.compiled.LAWS` (None: elastic).
+
+    Returns:
+        This module's namespace (a dict) with the new ``predict``, ``predict_all``, ``set_disc`` and
+        ``run_events``; :class:`~discsim.engines.event_driven.numba.backend.NumbaBackend` runs it as it runs
+        this module.
+    """
+    from types import FunctionType
+
+    from discsim._numba import numba
+    from discsim.physics.compiled import compile_parts
+
+    nb = numba()
+    namespace = dict(globals())
+    namespace.update(compile_parts(law_of_motion, collision_law))
+    for name in PHYSICAL:
+        dispatcher = globals()[name]
+        source = dispatcher.py_func
+        table = dict(source.__globals__)
+        table.update({key: namespace[key] for key in table if key in namespace})
+        rebuilt = FunctionType(source.__code__, table, source.__name__, source.__defaults__)
+        rebuilt.__qualname__ = source.__qualname__
+        options = {key: value for key, value in dispatcher.targetoptions.items() if key != "nopython"}
+        namespace[name] = nb.njit(cache=False, **options)(rebuilt)
+    return namespace

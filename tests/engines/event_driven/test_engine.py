@@ -314,7 +314,8 @@ def test_run_leaves_the_garbage_collector_as_it_found_it():
 def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
     """Each cell's getter, applied to its tile, returns the members of the grid's 3x3 block, in order."""
     from discsim.cells import CellGrid
-    from discsim.engines.event_driven.python.backend import _TILE, _tile_cells
+    from discsim.engines.event_driven.python.predictor import _TILE
+    from discsim.engines.event_driven.python.predictor import tile_cells as _tile_cells
 
     nx, ny = shape
     grid = CellGrid(ds.Box(float(nx), float(ny), periodic=periodic), 1.0)
@@ -333,7 +334,7 @@ def test_tiles_give_every_cell_its_3x3_block(periodic, shape):
 
 def test_cell_crossings_keep_ghost_copies_in_step():
     """After many crossings in a box of several tiles, every ghost copy is the cell's own tuple (``_check``)."""
-    from discsim.engines.event_driven.python.backend import _TILE
+    from discsim.engines.event_driven.python.layout import _TILE
 
     discs, box = ds.random_gas(1500, 0.3, periodic=True, seed=4)
     sim = ds.EventDriven(discs, box, record=False)

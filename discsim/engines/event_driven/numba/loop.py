@@ -427,7 +427,7 @@ def run_events(
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats,
     ev_t, ev_kind, ev_i, ev_j, ev_f,
 ):  # fmt: skip
-    """Process events with times <= ``until``: the Python backend's ``_process_events``, compiled.
+    """Process events with times <= ``until``: the Python backend's ``process_events``, compiled.
 
     Stops after ``limit`` physical events (-1: no limit), ``crossings`` cell crossings (-1: none),
     ``budget`` pops, or when the log buffer (``ev_*``, written when ``recording``) is full.

@@ -90,8 +90,7 @@ def task_name(task) -> str:
     """
     if isinstance(task, functools.partial):
         bound = {"args": [repr(a) for a in task.args], "keywords": task.keywords}
-        bound = json.dumps(bound, sort_keys=True, default=repr)
-        return f"{task_name(task.func)}{bound}"
+        return f"{task_name(task.func)}{json.dumps(bound, sort_keys=True, default=repr)}"
     module = getattr(task, "__module__", None) or "?"
     qualname = getattr(task, "__qualname__", None) or getattr(task, "__name__", None) or type(task).__qualname__
     return f"{module}:{qualname}"
@@ -150,7 +149,7 @@ def grid_points(grid) -> list[dict]:
     else:
         msg = f"grid must be a dict of lists or a list of dicts, got {type(grid).__name__}"
         raise WrongTypeError(msg)
-    seen = {}
+    seen: dict[str, int] = {}  # each point as JSON -> its index
     for k, point in enumerate(points):
         key = json.dumps(point, sort_keys=True)
         if key in seen:

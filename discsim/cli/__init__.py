@@ -2,7 +2,7 @@
 
 One module per command, each with ``add_parser(subparsers)`` (its options, and its handler as the parser's
 ``func`` default) and ``handle(args)`` (what it does, returning an exit code); :func:`build_parser` calls every
-``add_parser`` in turn. A new command is a new module and one line in :data:`_COMMANDS`, nothing else.
+``add_parser`` in turn. A new command is a new module, its import below and one entry in :data:`_COMMANDS`.
 
 Commands:
     demo (:mod:`discsim.cli.demo`): run the study's four PIT failure cases under PIC (exact) and PIT

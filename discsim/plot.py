@@ -23,6 +23,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import animation
 from matplotlib.collections import PatchCollection
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
@@ -598,9 +599,9 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
     return anim
 
 
-def _figure_of(obj):
+def _figure_of(obj: Any) -> Figure:
     if isinstance(obj, animation.Animation):
-        return obj._fig
+        return obj._fig  # type: ignore[attr-defined]  # the animation's figure, not in matplotlib's stubs
     return getattr(obj, "figure", obj)
 
 

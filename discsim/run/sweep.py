@@ -35,11 +35,15 @@ import traceback
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from discsim._validate import is_count
 from discsim.errors import InvalidArgumentError, WrongTypeError
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future, ProcessPoolExecutor
 
 __all__ = ["ERROR_COLUMN", "SEED_COLUMN", "grid_points", "seed_streams", "sweep", "task_name"]
 
@@ -316,7 +320,7 @@ class _Finished:
     def __init__(self):
         import queue
 
-        self._done = queue.SimpleQueue()
+        self._done: queue.SimpleQueue[Future] = queue.SimpleQueue()
 
     def track(self, future):
         future.add_done_callback(self._done.put)
@@ -339,9 +343,9 @@ class _LocalPool(_Finished):
         super().__init__()
         self.workers = workers
         self.label = f"{workers} local process{'es' if workers > 1 else ''}"
-        self._pool = None
+        self._pool: ProcessPoolExecutor | None = None
 
-    def _executor(self):
+    def _executor(self) -> ProcessPoolExecutor:
         if self._pool is None:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
@@ -353,10 +357,11 @@ class _LocalPool(_Finished):
     def submit(self, *args):
         from concurrent.futures.process import BrokenProcessPool
 
+        pool = self._executor()
         try:
-            return self.track(self._executor().submit(attempt, *args))
+            return self.track(pool.submit(attempt, *args))
         except BrokenProcessPool:  # a worker died: a new pool for what is left
-            self._pool.shutdown(wait=False, cancel_futures=True)
+            pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
             return self.track(self._executor().submit(attempt, *args))
 
@@ -586,7 +591,7 @@ def _run(pd, task, name, jobs, executor, store, retries, progress):
 
 def _table(pd, name, jobs, executor, store, resubmitted, seconds, retries):
     columns = [*jobs[0].params, SEED_COLUMN]
-    results = {}
+    results: dict[str, None] = {}  # the result keys of every job, in the order first seen
     for job in jobs:
         for key in job.result or ():
             results.setdefault(key, None)

@@ -24,7 +24,7 @@ def is_count(value) -> bool:
     """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         return False
-    return math.isfinite(value) and value >= 0 and int(value) == value
+    return bool(math.isfinite(value) and value >= 0 and int(value) == value)  # a NumPy value compares to np.bool_
 
 
 def check_count(name: str, value) -> int | None:

@@ -16,11 +16,14 @@ import math
 import textwrap
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
+import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import animation
 from matplotlib.collections import PatchCollection
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
@@ -34,7 +37,7 @@ _OBSTACLE = "0.55"
 
 
 def _colours(n: int) -> list:
-    cycle = plt.get_cmap("tab10").colors
+    cycle = matplotlib.color_sequences["tab10"]  # the colours of the tab10 colour map
     return [cycle[k % len(cycle)] for k in range(n)]
 
 
@@ -54,7 +57,7 @@ def _setup(ax, box) -> None:
     if box is None:
         ax.autoscale_view()
         return
-    style = {"linestyle": ":"} if box.periodic else {}
+    style: dict[str, Any] = {"linestyle": ":"} if box.periodic else {}
     ax.add_patch(Rectangle((0.0, 0.0), box.width, box.height, fill=False, edgecolor="0.2", linewidth=1.2, **style))
     pad = 0.02 * max(box.width, box.height)
     ax.set_xlim(-pad, box.width + pad)
@@ -588,15 +591,17 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
     update(0)
     anim = animation.FuncAnimation(fig, update, frames=len(times), interval=1000.0 / fps, blit=False)
     if path is not None:
-        writer = animation.PillowWriter(fps=fps) if path.suffix.lower() == ".gif" else animation.FFMpegWriter(fps=fps)
+        # matplotlib's stubs ask for an int, but both writers take any positive frame rate (1000 / fps ms a frame).
+        gif = path.suffix.lower() == ".gif"
+        writer = animation.PillowWriter(fps=fps) if gif else animation.FFMpegWriter(fps=fps)  # type: ignore[arg-type]
         path.parent.mkdir(parents=True, exist_ok=True)
         anim.save(str(path), writer=writer, dpi=dpi)
     return anim
 
 
-def _figure_of(obj):
+def _figure_of(obj: Any) -> Figure:
     if isinstance(obj, animation.Animation):
-        return obj._fig
+        return obj._fig  # type: ignore[attr-defined]  # the animation's figure, not in matplotlib's stubs
     return getattr(obj, "figure", obj)
 
 
@@ -622,5 +627,5 @@ def close(obj) -> None:
     if isinstance(obj, animation.Animation):
         obj.pause()
         # Discarded on purpose: spare the "Animation was deleted without rendering anything" warning.
-        obj._draw_was_started = True
+        obj._draw_was_started = True  # type: ignore[attr-defined]  # Animation's private flag, not in its stubs
     plt.close(_figure_of(obj))

@@ -7,23 +7,83 @@ than ``n_owners`` live events, over any horizon. Entries are ordered by
 break deterministically. The queue knows nothing of discs: validating an event
 (its collision counters) is the engine's job.
 
-Three implementations share one interface so that a benchmark can compare them:
-:class:`EventQueue` (a ``sortedcontainers.SortedList``, exact removal),
-:class:`HeapEventQueue` (``heapq`` with lazy deletion and compaction) and
-:class:`CalendarEventQueue` (a calendar of time bins in front of a small
-``SortedList``, O(1) amortised, after Paul 2007).
+Three implementations meet one protocol, :class:`EventQueueProtocol`, so that an
+engine takes any of them and a benchmark can compare them: :class:`EventQueue`
+(a ``sortedcontainers.SortedList``, exact removal), :class:`HeapEventQueue`
+(``heapq`` with lazy deletion and compaction) and :class:`CalendarEventQueue` (a
+calendar of time bins in front of a small ``SortedList``, O(1) amortised, after
+Paul 2007). They meet it structurally, without inheriting from it: the hot loop
+calls their methods directly, and ``isinstance(q, EventQueueProtocol)`` checks a
+queue at run time.
 """
 
 from __future__ import annotations
 
 import heapq
 import math
+from typing import TYPE_CHECKING, Generic, Protocol, TypeVar, runtime_checkable
 
 from sortedcontainers import SortedList
 
 _INF = math.inf
 
-__all__ = ["CalendarEventQueue", "EventQueue", "HeapEventQueue", "sift_down", "sift_up"]
+__all__ = ["CalendarEventQueue", "EventQueue", "EventQueueProtocol", "HeapEventQueue", "sift_down", "sift_up"]
+
+#: What an event carries, opaque to the queue (the engines push ``(kind, other, stamp)`` tuples of ints).
+Payload = TypeVar("Payload")
+
+
+@runtime_checkable
+class EventQueueProtocol(Protocol[Payload]):
+    """Earliest-first queue of at most one pending event per owner in ``range(n_owners)``.
+
+    Entries are ordered by ``(time, owner)``; ``push`` replaces the owner's event, and a time of
+    ``math.inf`` means no event. Every implementation pops the same events in the same order, bit for bit.
+
+    Example:
+        >>> isinstance(CalendarEventQueue(3), EventQueueProtocol)
+        True
+    """
+
+    def push(self, owner: int, time: float, payload: Payload) -> None:
+        """Schedule ``payload`` for ``owner`` at ``time``, replacing its pending event (``math.inf``: none)."""
+        ...
+
+    def pop_before(self, until: float) -> tuple[float, int, Payload] | None:
+        """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
+        ...
+
+    def pop(self) -> tuple[float, int, Payload]:
+        """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""
+        ...
+
+    def peek(self) -> float:
+        """Time of the earliest event, ``math.inf`` if the queue is empty."""
+        ...
+
+    def discard(self, owner: int) -> None:
+        """Drop ``owner``'s pending event, if any."""
+        ...
+
+    def pending(self, owner: int) -> tuple[float, Payload | None]:
+        """``(time, payload)`` of ``owner``'s pending event (``inf, None`` if none)."""
+        ...
+
+    def shift_times(self, delta: float) -> None:
+        """Subtract ``delta`` from every pending time (a new time origin)."""
+        ...
+
+    def __len__(self) -> int:
+        """Pending events."""
+        ...
+
+    def storage(self) -> int:
+        """Entries held in memory, replaced (dead) ones included; at least ``len``."""
+        ...
+
+    def _check(self) -> None:
+        """Assert every invariant; O(n). For tests."""
+        ...
 
 
 # --- an indexed binary heap over arrays, for the compiled loops ---------------------------------------------
@@ -80,7 +140,7 @@ def sift_down(k, size, heap, ht, hpos):
     hpos[owner] = k
 
 
-class EventQueue:
+class EventQueue(Generic[Payload]):
     """Earliest-first queue backed by a ``SortedList`` of ``(time, owner)`` keys.
 
     Runtime complexity: ``push`` and ``pop`` O(log n), ``peek`` and ``len`` O(1).
@@ -102,9 +162,9 @@ class EventQueue:
         self._keys._reset(self.LOAD)
         self._add, self._remove = self._keys.add, self._keys.remove
         self._time = [math.inf] * n_owners
-        self._payload: list = [None] * n_owners
+        self._payload: list[Payload | None] = [None] * n_owners  # None where the owner has no event
 
-    def push(self, owner: int, time: float, payload) -> None:
+    def push(self, owner: int, time: float, payload: Payload) -> None:
         """Schedule ``payload`` for ``owner`` at ``time``, replacing its pending event."""
         old = self._time[owner]
         if old != math.inf:
@@ -120,7 +180,7 @@ class EventQueue:
         self._keys.clear()
         self._keys.update((t, o) for o, t in enumerate(self._time) if t != math.inf)
 
-    def pop_before(self, until: float):
+    def pop_before(self, until: float) -> tuple[float, int, Payload] | None:
         """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
         keys = self._keys
         if not keys or keys[0][0] > until:
@@ -131,7 +191,7 @@ class EventQueue:
         self._payload[owner] = None
         return time, owner, payload
 
-    def pop(self) -> tuple[float, int, object]:
+    def pop(self) -> tuple[float, int, Payload]:
         """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""
         time, owner = self._keys.pop(0)
         self._time[owner] = math.inf
@@ -146,9 +206,9 @@ class EventQueue:
 
     def discard(self, owner: int) -> None:
         """Drop ``owner``'s pending event, if any."""
-        self.push(owner, math.inf, None)
+        self.push(owner, math.inf, None)  # type: ignore[arg-type]  # at time inf the payload is dropped
 
-    def pending(self, owner: int) -> tuple[float, object]:
+    def pending(self, owner: int) -> tuple[float, Payload | None]:
         """``(time, payload)`` of ``owner``'s pending event (``inf, None`` if none)."""
         return self._time[owner], self._payload[owner]
 
@@ -166,7 +226,7 @@ class EventQueue:
         assert sorted(live) == list(self._keys), "keys and per-owner times disagree"
 
 
-class HeapEventQueue:
+class HeapEventQueue(Generic[Payload]):
     """Earliest-first queue backed by ``heapq`` with lazy deletion.
 
     A replaced event stays in the heap as a dead entry, recognised by its
@@ -183,13 +243,13 @@ class HeapEventQueue:
     """
 
     def __init__(self, n_owners: int):
-        self._heap: list = []
+        self._heap: list[tuple[float, int, int]] = []  # (time, owner, version); dead where the version is old
         self._time = [math.inf] * n_owners
         self._version = [0] * n_owners
-        self._payload: list = [None] * n_owners
+        self._payload: list[Payload | None] = [None] * n_owners  # None where the owner has no event
         self._live = 0
 
-    def push(self, owner: int, time: float, payload) -> None:
+    def push(self, owner: int, time: float, payload: Payload) -> None:
         """Schedule ``payload`` for ``owner`` at ``time``, replacing its pending event."""
         if self._time[owner] != math.inf:
             self._live -= 1
@@ -217,7 +277,7 @@ class HeapEventQueue:
         while heap and heap[0][2] != version[heap[0][1]]:
             heapq.heappop(heap)
 
-    def pop_before(self, until: float):
+    def pop_before(self, until: float) -> tuple[float, int, Payload] | None:
         """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
         heap, version = self._heap, self._version
         while heap and heap[0][2] != version[heap[0][1]]:
@@ -230,9 +290,9 @@ class HeapEventQueue:
         self._live -= 1
         payload = self._payload[owner]
         self._payload[owner] = None
-        return time, owner, payload
+        return time, owner, payload  # type: ignore[return-value]  # an owner with an event holds its payload
 
-    def pop(self) -> tuple[float, int, object]:
+    def pop(self) -> tuple[float, int, Payload]:
         """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""
         self._drop_dead()
         time, owner, _ = heapq.heappop(self._heap)
@@ -241,7 +301,7 @@ class HeapEventQueue:
         self._live -= 1
         payload = self._payload[owner]
         self._payload[owner] = None
-        return time, owner, payload
+        return time, owner, payload  # type: ignore[return-value]  # an owner with an event holds its payload
 
     def peek(self) -> float:
         """Time of the earliest event, ``math.inf`` if the queue is empty."""
@@ -250,9 +310,9 @@ class HeapEventQueue:
 
     def discard(self, owner: int) -> None:
         """Drop ``owner``'s pending event, if any."""
-        self.push(owner, math.inf, None)
+        self.push(owner, math.inf, None)  # type: ignore[arg-type]  # at time inf the payload is dropped
 
-    def pending(self, owner: int) -> tuple[float, object]:
+    def pending(self, owner: int) -> tuple[float, Payload | None]:
         """``(time, payload)`` of ``owner``'s pending event (``inf, None`` if none)."""
         return self._time[owner], self._payload[owner]
 
@@ -274,7 +334,7 @@ class HeapEventQueue:
         assert len(self._heap) <= 2 * len(self._time) + 16
 
 
-class CalendarEventQueue:
+class CalendarEventQueue(Generic[Payload]):
     """Earliest-first calendar queue: a small ``SortedList`` for the current time bin, plain lists beyond.
 
     After G. Paul, J. Comput. Phys. 221 (2007) 615. Time is cut into bins of
@@ -331,11 +391,11 @@ class CalendarEventQueue:
         self._near = SortedList()
         self._near._reset(EventQueue.LOAD)  # helps when many events share the current bin (ties, bursts)
         self._near_add, self._near_remove = self._near.add, self._near.remove
-        self._entry: list = [None] * n_owners  # the owner's live (time, owner, payload) tuple, or None
+        self._entry: list[tuple[float, int, Payload] | None] = [None] * n_owners  # the owner's live entry, or None
         self._live = 0
         self._dead = 0
         self._max_dead = 2 * n_owners + 64
-        self._overflow: list = []
+        self._overflow: list[tuple[float, int, Payload]] = []
         self._rate = 0.0  # events per unit time measured over the last lap (0: unknown)
         self._start(0.0, 1.0, 0)
 
@@ -344,7 +404,7 @@ class CalendarEventQueue:
         self._base = base
         self._width = width
         self._inv_w = 1.0 / width
-        self._bins: list = [[] for _ in range(n_bins)]
+        self._bins: list[list[tuple[float, int, Payload]]] = [[] for _ in range(n_bins)]
         self._n_bins = n_bins
         if n_bins:
             self._span = float(n_bins)  # x = (t - base) / w at the end of the lap
@@ -356,7 +416,7 @@ class CalendarEventQueue:
         self._loaded = 0  # live entries loaded from bins during this lap
         self._direct = 0  # events pushed straight into the SortedList during this lap
 
-    def _rebin(self, live: list) -> None:
+    def _rebin(self, live: list[tuple[float, int, Payload]]) -> None:
         """Start a new lap holding exactly the live entries ``live`` (the SortedList must be empty)."""
         self._dead = 0
         if not live:
@@ -427,7 +487,7 @@ class CalendarEventQueue:
             self._rate = max(self._loaded + self._direct, 1) / (self._span * self._width)
         self._rebin([e for e in overflow if entry[e[1]] is e])
 
-    def push(self, owner: int, time: float, payload) -> None:
+    def push(self, owner: int, time: float, payload: Payload) -> None:
         """Schedule ``payload`` for ``owner`` at ``time``, replacing its pending event."""
         entries = self._entry
         old = entries[owner]
@@ -467,7 +527,7 @@ class CalendarEventQueue:
         self._near.clear()
         self._rebin([e for e in entries if e is not None])
 
-    def pop_before(self, until: float):
+    def pop_before(self, until: float) -> tuple[float, int, Payload] | None:
         """Pop the earliest ``(time, owner, payload)`` if its time is <= ``until``, else return None."""
         near = self._near
         if not near:
@@ -482,7 +542,7 @@ class CalendarEventQueue:
         self._live -= 1
         return e
 
-    def pop(self) -> tuple[float, int, object]:
+    def pop(self) -> tuple[float, int, Payload]:
         """Remove and return the earliest ``(time, owner, payload)``; IndexError if empty."""
         if not self._near:
             self._advance()
@@ -500,9 +560,9 @@ class CalendarEventQueue:
 
     def discard(self, owner: int) -> None:
         """Drop ``owner``'s pending event, if any."""
-        self.push(owner, math.inf, None)
+        self.push(owner, math.inf, None)  # type: ignore[arg-type]  # at time inf the payload is dropped
 
-    def pending(self, owner: int) -> tuple[float, object]:
+    def pending(self, owner: int) -> tuple[float, Payload | None]:
         """``(time, payload)`` of ``owner``'s pending event (``inf, None`` if none)."""
         e = self._entry[owner]
         return (math.inf, None) if e is None else (e[0], e[2])
@@ -539,3 +599,13 @@ class CalendarEventQueue:
         assert held == self._live + self._dead == self.storage()
         assert self._dead <= self._max_dead
         assert self.storage() <= 3 * self._n_owners + 64
+
+
+if TYPE_CHECKING:  # nothing runs here: mypy checks that each queue meets the protocol, method by method
+    from collections.abc import Callable
+
+    _QUEUES: tuple[Callable[[int], EventQueueProtocol[object]], ...] = (
+        EventQueue,
+        HeapEventQueue,
+        CalendarEventQueue,
+    )

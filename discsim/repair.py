@@ -282,7 +282,7 @@ class _Pairs:
         self.skin = 0.5 * float(discs.radii.max())
         masses = discs.masses
         self.inverse = np.where(np.isfinite(masses), 1.0 / masses, 0.0)  # obstacles: 0, they never move
-        self.listed_at = None
+        self.listed_at: np.ndarray | None = None  # the positions when the candidate pairs were listed
 
     def sweep(self, pos: np.ndarray) -> None:
         """Push every overlapping pair apart in the order ``(i, j)``, each seeing the moves before it."""

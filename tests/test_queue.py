@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 import random
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -11,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule
 
-from discsim.queue import CalendarEventQueue, EventQueue, HeapEventQueue
+from discsim.queue import CalendarEventQueue, EventQueue, EventQueueProtocol, HeapEventQueue
 
 # A calendar with tiny bins, so that small queues already use many bins, dead entries,
 # the overflow and the drift re-binning (the default needs some 20 events per bin).
@@ -309,6 +311,44 @@ def test_empty_queue(cls):
     q.push(0, 2.0, "y")
     assert q.pop_before(1.0) is None and q.pop_before(2.0) == (2.0, 0, "y")
     q._check()
+
+
+# --- the protocol the three queues meet -----------------------------------------------------------------------
+def _methods(cls: type) -> set[str]:
+    """The methods ``cls`` defines in its own body, ``__init__`` and the protocol machinery left out."""
+    return {n for n, v in vars(cls).items() if inspect.isfunction(v)} - {"__init__", "__subclasshook__"}
+
+
+def _drain(queue: EventQueueProtocol[str], until: float) -> list[tuple[float, int, str]]:
+    """Pop every event up to ``until``, through the protocol only (mypy checks the calls against it)."""
+    popped = []
+    while (event := queue.pop_before(until)) is not None:
+        popped.append(event)
+    return popped
+
+
+@pytest.mark.parametrize("cls", ALL_QUEUES)
+def test_every_queue_meets_the_protocol(cls: Callable[[int], EventQueueProtocol[str]]) -> None:
+    queue = cls(4)
+    assert isinstance(queue, EventQueueProtocol)
+    for owner, time, payload in [(0, 3.0, "a"), (1, 1.0, "b"), (2, 2.0, "c"), (3, 2.0, "d"), (1, 4.0, "e")]:
+        queue.push(owner, time, payload)
+    queue.discard(0)
+    queue.shift_times(1.0)
+    assert len(queue) == 3 and queue.storage() >= 3 and queue.peek() == 1.0
+    assert queue.pending(1) == (3.0, "e") and queue.pending(0) == (math.inf, None)
+    assert _drain(queue, 1.0) == [(1.0, 2, "c"), (1.0, 3, "d")]
+    assert queue.pop() == (3.0, 1, "e") and len(queue) == 0
+    queue._check()
+
+
+def test_the_protocol_names_the_whole_shared_interface() -> None:
+    """What all three queues define is in the protocol, and a class that lacks one method does not meet it."""
+    shared = set.intersection(*(_methods(cls) for cls in QUEUES))
+    assert _methods(EventQueueProtocol) == shared
+    for missing in sorted(shared):
+        lacking = type("Lacking", (), {n: getattr(EventQueue, n) for n in shared - {missing}})
+        assert not isinstance(lacking(), EventQueueProtocol), missing
 
 
 # --- the compiled event loop's queue: each disc's pending time and a heap of blocks of discs ----------------

@@ -373,7 +373,8 @@ def read_stream(path, *, partial: bool = False) -> RecordStream:
     """
     walk = iter_stream(path, partial=partial)
     meta, arrays, empty, end = next(walk)
-    pieces, last = [empty], {}
+    pieces: list[np.ndarray] = [empty]
+    last: dict = {}
     for last, _, records, end in walk:  # noqa: B007 (last and end are used after the loop)
         pieces.append(records)
     records = np.concatenate(pieces)
@@ -504,7 +505,9 @@ class RecordWriter:
                     raise CheckpointError(msg)
             else:
                 handle.seek(last_start)
-                meta, chunk, _ = _read_block(handle, str(path), size)
+                block = _read_block(handle, str(path), size)
+                assert block is not None  # not the end of the file: last_start < end <= size
+                meta, chunk, _ = block
                 got = chunk.get("records")
                 if got is None or got.dtype != dtype or meta.get("first", -1) + len(got) != records:
                     msg = f"{path}: the chunk ending at byte {end} does not end at record {records} (damaged log)"

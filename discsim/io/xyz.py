@@ -22,6 +22,7 @@ are not stored: a file read back has ``unwrapped`` equal to ``positions``.
 from __future__ import annotations
 
 import shlex
+from os import PathLike
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,8 @@ __all__ = ["read_xyz", "write_xyz"]
 #: Placeholder species for the groups, so that ASE can build Atoms (the group label is its own column).
 SYMBOLS = "H He Li Be B C N O F Ne Na Mg Al Si P S Cl Ar K Ca Sc Ti V Cr Mn Fe Co Ni Cu Zn Ga Ge As Se Br Kr".split()
 PROPERTIES = "species:S:1:pos:R:3:radius:R:1:velo:R:3:mass:R:1:group:I:1"
+#: The columns read as numbers: a file that declares one of them text (type S) is refused.
+_NUMBERS = ("pos", "radius", "velo", "mass", "group")
 
 
 def write_xyz(path, source, times=None) -> Path:
@@ -88,7 +91,7 @@ def write_xyz(path, source, times=None) -> Path:
     return path
 
 
-def _parse_comment(line: str, path, frame: int) -> dict:
+def _parse_comment(line: str, path: Path, frame: int) -> dict[str, str]:
     try:
         words = shlex.split(line)
     except ValueError as exc:
@@ -102,7 +105,7 @@ def _parse_comment(line: str, path, frame: int) -> dict:
     return out
 
 
-def read_xyz(path) -> Frames:
+def read_xyz(path: str | PathLike[str]) -> Frames:
     """Read an extended XYZ file of discs (as :func:`write_xyz` writes) as Frames.
 
     Needs ``Lattice`` (a rectangle in the xy plane) and ``Properties`` with ``pos``; ``radius`` (default 0.5),
@@ -120,8 +123,10 @@ def read_xyz(path) -> Frames:
         raise FileNotFoundError(msg)
     lines = path.read_text().splitlines()
     at, frame = 0, 0
-    times, positions, velocities = [], [], []
-    box = radii = masses = groups = None
+    times: list[float] = []
+    positions: list[np.ndarray] = []
+    velocities: list[np.ndarray] = []
+    first: tuple[Box, np.ndarray, np.ndarray, np.ndarray] | None = None  # frame 0's box, radii, masses, groups
     while at < len(lines):
         if not lines[at].strip():
             at += 1
@@ -142,17 +147,21 @@ def read_xyz(path) -> Frames:
         if any(len(row) != width for row in rows):
             msg = f"{path}: frame {frame} has lines without the {width} columns its Properties name"
             raise InvalidArgumentError(msg)
-        table = {}
+        table: dict[str, np.ndarray] = {}  # (n, count) floats, or strings for a column of type S
         start = 0
         for name, kind, count in columns:
             values = [row[start : start + count] for row in rows]
-            if kind != "S":
+            if kind == "S":
+                if name in _NUMBERS:
+                    msg = f"{path}: frame {frame}: column {name} is declared text (S); it must hold numbers"
+                    raise InvalidArgumentError(msg)
+                table[name] = np.array(values, dtype=str).reshape(n, count)
+            else:
                 try:
-                    values = np.array(values, dtype=float)
+                    table[name] = np.array(values, dtype=float).reshape(n, count)
                 except ValueError as exc:
                     msg = f"{path}: frame {frame}: column {name} holds values that are not numbers"
                     raise InvalidArgumentError(msg) from exc
-            table[name] = values
             start += count
         if "pos" not in table:
             msg = f"{path}: frame {frame}'s Properties hold no pos column"
@@ -161,8 +170,7 @@ def read_xyz(path) -> Frames:
         if pos.shape[1] > 2 and np.any(pos[:, 2] != 0.0):
             msg = f"{path} holds 3D data: frame {frame} has discs off the plane z = 0"
             raise InvalidArgumentError(msg)
-        if box is None:
-            box = frame_box
+        if first is None:
             radii = table["radius"][:, 0] if "radius" in table else np.full(n, 0.5)
             masses = table["mass"][:, 0] if "mass" in table else np.ones(n)
             if "group" in table:
@@ -172,22 +180,24 @@ def read_xyz(path) -> Frames:
                 groups = np.unique(names, return_inverse=True)[1].reshape(-1)
             else:
                 groups = np.zeros(n, dtype=np.int64)
-        elif frame_box != box or n != len(radii):
+            first = (frame_box, radii, masses, groups)
+        elif frame_box != first[0] or n != len(first[1]):
             msg = f"{path}: frame {frame} differs from frame 0 in its box or its number of discs"
             raise InvalidArgumentError(msg)
         times.append(float(info.get("time", frame)))
-        positions.append(box.wrap(pos[:, :2]))
+        positions.append(first[0].wrap(pos[:, :2]))
         velocities.append(table["velo"][:, :2] if "velo" in table else np.zeros((n, 2)))
         at += 2 + n
         frame += 1
-    if box is None:
+    if first is None:
         msg = f"{path} holds no frame"
         raise InvalidArgumentError(msg)
-    positions = np.array(positions)
-    return Frames(np.array(times), positions, positions.copy(), np.array(velocities), box, radii, masses, groups)
+    box, radii, masses, groups = first
+    wrapped = np.array(positions)
+    return Frames(np.array(times), wrapped, wrapped.copy(), np.array(velocities), box, radii, masses, groups)
 
 
-def _box(info: dict, path, frame: int) -> Box:
+def _box(info: dict[str, str], path: Path, frame: int) -> Box:
     if "lattice" not in info:
         msg = f'{path}: frame {frame} has no Lattice="..." (not extended XYZ, or no cell)'
         raise InvalidArgumentError(msg)
@@ -206,7 +216,7 @@ def _box(info: dict, path, frame: int) -> Box:
     return Box(float(cell[0, 0]), float(cell[1, 1]), periodic=bool(pbc) and pbc[0].upper().startswith("T"))
 
 
-def _columns(info: dict, path, frame: int) -> list[tuple[str, str, int]]:
+def _columns(info: dict[str, str], path: Path, frame: int) -> list[tuple[str, str, int]]:
     spec = info.get("properties", "species:S:1:pos:R:3").split(":")
     if len(spec) % 3:
         msg = f"{path}: frame {frame}'s Properties {':'.join(spec)!r} are not name:type:count triples"

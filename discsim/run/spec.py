@@ -18,6 +18,7 @@ A list of points is written ``[[grid]]`` tables instead, one per point.
 from __future__ import annotations
 
 import importlib
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -87,9 +88,9 @@ def read_spec(path) -> SweepSpec:
         InvalidArgumentError: naming the file and the key, for a file that cannot be read or parsed, an
             unknown key, or a missing task or grid.
     """
-    try:
+    if sys.version_info >= (3, 11):
         import tomllib
-    except ImportError:  # Python 3.10
+    else:  # Python 3.10
         import tomli as tomllib
     path = Path(path)
     try:

@@ -35,11 +35,15 @@ import traceback
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from discsim._validate import is_count
 from discsim.errors import InvalidArgumentError, WrongTypeError
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future, ProcessPoolExecutor
 
 __all__ = ["ERROR_COLUMN", "SEED_COLUMN", "grid_points", "seed_streams", "sweep", "task_name"]
 
@@ -90,8 +94,7 @@ def task_name(task) -> str:
     """
     if isinstance(task, functools.partial):
         bound = {"args": [repr(a) for a in task.args], "keywords": task.keywords}
-        bound = json.dumps(bound, sort_keys=True, default=repr)
-        return f"{task_name(task.func)}{bound}"
+        return f"{task_name(task.func)}{json.dumps(bound, sort_keys=True, default=repr)}"
     module = getattr(task, "__module__", None) or "?"
     qualname = getattr(task, "__qualname__", None) or getattr(task, "__name__", None) or type(task).__qualname__
     return f"{module}:{qualname}"
@@ -150,7 +153,7 @@ def grid_points(grid) -> list[dict]:
     else:
         msg = f"grid must be a dict of lists or a list of dicts, got {type(grid).__name__}"
         raise WrongTypeError(msg)
-    seen = {}
+    seen: dict[str, int] = {}  # each point as JSON -> its index
     for k, point in enumerate(points):
         key = json.dumps(point, sort_keys=True)
         if key in seen:
@@ -317,7 +320,7 @@ class _Finished:
     def __init__(self):
         import queue
 
-        self._done = queue.SimpleQueue()
+        self._done: queue.SimpleQueue[Future] = queue.SimpleQueue()
 
     def track(self, future):
         future.add_done_callback(self._done.put)
@@ -340,9 +343,9 @@ class _LocalPool(_Finished):
         super().__init__()
         self.workers = workers
         self.label = f"{workers} local process{'es' if workers > 1 else ''}"
-        self._pool = None
+        self._pool: ProcessPoolExecutor | None = None
 
-    def _executor(self):
+    def _executor(self) -> ProcessPoolExecutor:
         if self._pool is None:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
@@ -354,10 +357,11 @@ class _LocalPool(_Finished):
     def submit(self, *args):
         from concurrent.futures.process import BrokenProcessPool
 
+        pool = self._executor()
         try:
-            return self.track(self._executor().submit(attempt, *args))
+            return self.track(pool.submit(attempt, *args))
         except BrokenProcessPool:  # a worker died: a new pool for what is left
-            self._pool.shutdown(wait=False, cancel_futures=True)
+            pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
             return self.track(self._executor().submit(attempt, *args))
 
@@ -587,7 +591,7 @@ def _run(pd, task, name, jobs, executor, store, retries, progress):
 
 def _table(pd, name, jobs, executor, store, resubmitted, seconds, retries):
     columns = [*jobs[0].params, SEED_COLUMN]
-    results = {}
+    results: dict[str, None] = {}  # the result keys of every job, in the order first seen
     for job in jobs:
         for key in job.result or ():
             results.setdefault(key, None)

@@ -19,13 +19,19 @@ A law of motion is a module with these five functions and the same signatures: u
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, TypeVar
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["advance", "exit_x", "exit_y", "pair_time_of_impact", "segment_time_of_impact"]
 
 INF = math.inf
+#: A float, or a numpy array of them (``advance`` takes either: the loops pass floats, trajectories arrays).
+Real = TypeVar("Real", float, "np.ndarray")
 
 
-def advance(x: float, y: float, vx: float, vy: float, dt: float) -> tuple[float, float, float, float]:
+def advance(x: Real, y: Real, vx: Real, vy: Real, dt: Real) -> tuple[Real, Real, Real, Real]:
     """A disc's centre and velocity ``dt`` after a time at which it was at ``(x, y)`` moving at ``(vx, vy)``.
 
     Args:

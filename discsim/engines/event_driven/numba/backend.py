@@ -83,7 +83,7 @@ class NumbaBackend:
         sizes = np.array([len(s) for s in near], dtype=np.int64)
         self._seg_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         self._seg_idx = np.array([k for s in near for k in s], dtype=np.int64)
-        self._events = None
+        self._events: tuple[np.ndarray, ...] | None = None  # the log buffer, made on the first recorded run
 
     # --- the protocol --------------------------------------------------------------------
     def start(self, state: EventDrivenState | None = None) -> None:
@@ -246,7 +246,7 @@ class NumbaBackend:
                 np.empty(LOG_ROWS, dtype=np.int64),
                 np.empty((LOG_ROWS, 8)),
             )
-        events = self._events if recording else _NO_EVENTS
+        events: tuple[np.ndarray, ...] = self._events if self._events is not None and recording else _NO_EVENTS
         args = self._loop_args()
         done = 0
         while True:
@@ -263,7 +263,7 @@ class NumbaBackend:
                         *events,
                     )
                     done += k
-                    if logged:
+                    if logged and log is not None:  # logged > 0 only when recording
                         log.extend(_records(events, logged))
                     if crossings >= 0:
                         crossings -= crossed

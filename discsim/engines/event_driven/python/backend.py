@@ -23,6 +23,7 @@ the counter, advance the discs involved, resolve, record, re-predict, push).
 from __future__ import annotations
 
 import gc
+from collections.abc import Callable
 
 import numpy as np
 
@@ -45,13 +46,17 @@ from discsim.engines.event_driven.python.predictor import make_predictor
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EventLog
 from discsim.physics.dynamics import advance
-from discsim.queue import CalendarEventQueue, EventQueue, HeapEventQueue
+from discsim.queue import CalendarEventQueue, EventQueue, EventQueueProtocol, HeapEventQueue
 from discsim.scene import Scene
 
 __all__ = ["QUEUES", "PythonBackend"]
 
 #: The event queues, by name; all give the same events bit for bit.
-QUEUES = {"calendar": CalendarEventQueue, "sorted": EventQueue, "heap": HeapEventQueue}
+QUEUES: dict[str, Callable[[int], EventQueueProtocol[tuple[int, int, int]]]] = {
+    "calendar": CalendarEventQueue,
+    "sorted": EventQueue,
+    "heap": HeapEventQueue,
+}
 
 
 class PythonBackend:
@@ -70,6 +75,15 @@ class PythonBackend:
     """
 
     name = "python"
+    # The state (built by load and make_predictor), typed for readers and mypy.
+    _queue: EventQueueProtocol[tuple[int, int, int]]
+    _predict: Callable[..., None]
+    _predictions: Callable[[], int]
+    _where: list[tuple]  # each disc's cell record
+    _cell_info: list[tuple]  # each cell's static record
+    max_queue: int
+    max_overlap: float
+    time: float
 
     def __init__(self, scene: Scene, grid: CellGrid, queue: str):
         self.scene = scene
@@ -165,8 +179,11 @@ class PythonBackend:
         cells = self._cell_members()
         members = np.array([j for m in cells for j in m], dtype=np.int64)
         partner = np.array(self._kept_partner, dtype=np.int64)
-        pending = [(o, *self._queue.pending(o)) for o in range(n)]
-        pending = [(o, t, p) for o, t, p in pending if t != INF]
+        pending: list[tuple[int, float, tuple[int, int, int]]] = []  # (owner, time, payload) of each event
+        for o in range(n):
+            t, p = self._queue.pending(o)
+            if t != INF and p is not None:
+                pending.append((o, t, p))
         kinds = np.array([p[0] for _, _, p in pending], dtype=np.int64)
         others = np.array([p[1] for _, _, p in pending], dtype=np.int64)
         last = self._last

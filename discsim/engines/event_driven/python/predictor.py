@@ -9,7 +9,9 @@ cross-backend tests hold the two to the same events bit for bit.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from operator import itemgetter
+from typing import Any
 
 from discsim.cells import CellGrid
 from discsim.engines.event_driven.python.layout import (
@@ -98,7 +100,7 @@ def make_predictor(backend, n_pred: int, cells: list[tuple[int, ...]], cell: lis
     predict_segment = segments.predict
     # The payloads of wall, crossing and segment events, made once and shared:
     # ``payloads[kind][other]``. A pop then reads no freshly scattered tuple for them.
-    payloads = [
+    payloads: list[Any] = [
         None,
         [(_WALL, 0, 0), (_WALL, 1, 0)],
         [(_CROSSING, direction, 0) for direction in range(4)],
@@ -117,13 +119,14 @@ def make_predictor(backend, n_pred: int, cells: list[tuple[int, ...]], cell: lis
         # 1. The earliest collision with a neighbour.
         partner = kept_partner[i]
         after_crossing = direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i])
+        near: Iterable[tuple[Any, Any]]
         if after_crossing:  # the 3 cells that just became adjacent; the kept collision covers the other 6
             k0, k1, k2 = front[direction]
             near = ((block[k0], shift[k0]), (block[k1], shift[k1]), (block[k2], shift[k2]))
         else:
             near = zip(block, shift)
         best, new_partner = INF, -1
-        passes = blocked[group[i]] if filtering else None
+        passes: Any = blocked[group[i]] if filtering else None
         for others, (sx, sy) in near:
             if not others:
                 continue
@@ -249,7 +252,7 @@ def tile_cells(grid: CellGrid, members: list[tuple[int, ...]], periodic: bool):
     for x0 in range(0, nx, _TILE):
         for y0 in range(0, ny, _TILE):
             w, h = min(_TILE, nx - x0), min(_TILE, ny - y0)
-            tile = [()] * (size * size)
+            tile: list[tuple[int, ...]] = [()] * (size * size)
             for lx in range(w + 2):
                 for ly in range(h + 2):
                     cx, cy = x0 + lx - 1, y0 + ly - 1

@@ -18,14 +18,25 @@ implements three small protocols, all here as abstract methods:
 
 Everything else (``run``, ``save``, ``events``, exact ``trajectory``, energies, momentum, ``snapshot``) is
 written here once, so ``compare``, ``plot``, notebooks and benchmarks work with any engine and backend.
-``run`` and ``save`` hand the engine to the driver and to :mod:`discsim.io`, imported when called: those
-layers sit above the engines, which never import them at module level.
+
+Two tables join the engines to the layers above without an import pointing up, not even inside a function:
+
+- the **registry**: each engine class adds itself where it is defined (``@register_engine``), and
+  :mod:`discsim.io.checkpoints` finds the class a file names with :func:`engine_class`, so a new engine
+  edits no module of ``io/``;
+- the **services**: ``Engine.run`` and ``Engine.save`` are thin delegates to the functions that
+  :mod:`discsim.run.driver` and :mod:`discsim.io.checkpoints` hand down with :func:`provide` when they are
+  imported. ``import discsim`` imports both (as does any ``import discsim.<module>``, since Python imports
+  the package first), so every engine can run and save. The cut sits here, rather than the driver patching
+  ``Engine.run`` or the engine importing the driver late, because it keeps the engine's methods where a
+  reader looks for them, keeps their docstrings, and lets ``tests/test_architecture.py`` check every import.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
@@ -45,7 +56,72 @@ from discsim.repair import Repair, restart_scene
 from discsim.scene import Scene, check_added
 from discsim.trajectory import positions_from_log
 
-__all__ = ["Engine", "EngineState"]
+__all__ = ["Engine", "EngineState", "engine_class", "provide", "register_engine", "registered_engines"]
+
+#: Engine classes by name (the name a checkpoint stores): see :func:`register_engine`.
+_ENGINES: dict[str, type[Engine]] = {}
+#: What the layers above provide to the engines, by service name: see :func:`provide`.
+_SERVICES: dict[str, Callable] = {}
+#: The services an engine uses, and the module that provides each.
+SERVICES = {"run": "discsim.run.driver", "save": "discsim.io.checkpoints"}
+
+
+def register_engine(cls: type[Engine]) -> type[Engine]:
+    """Class decorator: add engine class ``cls`` to the registry under its name; returns ``cls``.
+
+    Raises:
+        WrongTypeError: if ``cls`` is not a subclass of :class:`Engine`.
+        InvalidArgumentError: if another class is registered under the same name.
+    """
+    if not (isinstance(cls, type) and issubclass(cls, Engine)):
+        msg = f"register_engine needs a subclass of discsim.engines.base.Engine, got {cls!r}"
+        raise WrongTypeError(msg)
+    known = _ENGINES.get(cls.__name__)
+    if known is not None and (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
+        msg = f"an engine named {cls.__name__!r} is registered already ({known.__module__}.{known.__qualname__})"
+        raise InvalidArgumentError(msg)
+    _ENGINES[cls.__name__] = cls
+    return cls
+
+
+def registered_engines() -> dict[str, type[Engine]]:
+    """The registered engine classes by name (a new dict)."""
+    return dict(_ENGINES)
+
+
+def engine_class(name: str) -> type[Engine]:
+    """The registered engine class called ``name``.
+
+    Raises:
+        InvalidArgumentError: for a name no engine is registered under, naming the known ones.
+    """
+    try:
+        return _ENGINES[name]
+    except (KeyError, TypeError):
+        msg = f"no engine is registered as {name!r} (known: {sorted(_ENGINES)})"
+        raise InvalidArgumentError(msg) from None
+
+
+def provide(service: str, fn: Callable) -> None:
+    """Hand ``fn`` down to the engines as ``service`` (one of :data:`SERVICES`): the implementation behind
+    ``Engine.run`` (``fn(engine, until, **options)``) or ``Engine.save`` (``fn(engine, path)``).
+
+    Raises:
+        InvalidArgumentError: an unknown service, or an ``fn`` that is not callable.
+    """
+    if service not in SERVICES or not callable(fn):
+        msg = f"provide() takes one of {sorted(SERVICES)} and a callable, got {service!r} and {fn!r}"
+        raise InvalidArgumentError(msg)
+    _SERVICES[service] = fn
+
+
+def _service(service: str) -> Callable:
+    """The function provided as ``service``; raises DiscsimError (naming the module to import) if none was."""
+    fn = _SERVICES.get(service)
+    if fn is None:
+        msg = f"Engine.{service}() needs {SERVICES[service]}, which provides it when imported: import discsim"
+        raise DiscsimError(msg)
+    return fn
 
 
 class EngineState:
@@ -558,16 +634,10 @@ class Engine(ABC):
         Returns:
             ``self``, so calls chain.
         """
-        from discsim.run.driver import drive
-
-        if self._handlers:  # sim.on(...): one event (or frame) at a time, callbacks after each
-            from discsim.run.handlers import EventHandlers
-
-            observers = [*(observers or ()), EventHandlers(self._handlers)]
-        drive(
+        _service("run")(
             self,
-            until=until,
-            limit=events,
+            until,
+            events=events,
             observers=observers,
             progress=progress,
             record_to=record_to,
@@ -593,10 +663,8 @@ class Engine(ABC):
             >>> a.run(until=3.0).events.tobytes() == b.run(until=3.0).events.tobytes()
             True
         """
-        from discsim.io.checkpoints import save
-
         self._check_usable()
-        return save(self, path)
+        return _service("save")(self, path)
 
     @property
     def events(self) -> np.ndarray:

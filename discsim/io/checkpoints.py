@@ -18,19 +18,23 @@ Typical use::
     sim.run(until=1e4, record_to="run/events.dse", checkpoint="run/state.dsc", checkpoint_every=10**6)
     # ... killed at any moment; later, in a new process:
     sim = ds.resume("run/state.dsc")         # same final state, bit for bit
+
+This module imports no engine: it finds the class a file names in the registry
+(:func:`discsim.engines.base.engine_class`), where each engine adds itself, and it provides
+``Engine.save`` (:func:`save`) to the engines when imported (:func:`discsim.engines.base.provide`).
 """
 
 from __future__ import annotations
 
 import uuid
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from discsim._numba import available as numba_available
 from discsim._numba import resolve_backend
-from discsim.engines.event_driven import EventDriven, EventDrivenState
-from discsim.engines.fixed_step import FixedStep
+from discsim.engines.base import EngineState, provide, registered_engines
 from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
@@ -40,8 +44,6 @@ from discsim.trajectory import reconstruct
 
 __all__ = ["checkpoint_info", "load", "resume", "save", "write_checkpoint"]
 
-#: Engines a checkpoint can hold, by the name stored in the file.
-ENGINES = {"EventDriven": EventDriven, "FixedStep": FixedStep}
 #: The layout of the JSON document and the arrays written by this version.
 LAYOUT = 2
 
@@ -157,10 +159,21 @@ def checkpoint_info(path) -> dict:
 
 def _engine_class(meta, path) -> type:
     engine = meta.get("engine") if isinstance(meta, dict) else None
-    if engine not in ENGINES:
-        msg = f"{path}: not a discsim checkpoint (engine {engine!r}; known: {sorted(ENGINES)})"
+    engines = registered_engines()
+    if not isinstance(engine, str) or engine not in engines:
+        msg = f"{path}: not a discsim checkpoint (engine {engine!r}; known: {sorted(engines)})"
         raise CheckpointError(msg)
-    return ENGINES[engine]
+    return engines[engine]
+
+
+def __getattr__(name: str):
+    """``ENGINES``, the old table of engines by name: now :func:`discsim.engines.base.registered_engines`."""
+    if name == "ENGINES":
+        msg = "discsim.io.checkpoints.ENGINES is deprecated: use discsim.engines.base.registered_engines()"
+        warnings.warn(msg, DeprecationWarning, stacklevel=2)
+        return registered_engines()
+    msg = f"module {__name__!r} has no attribute {name!r}"
+    raise AttributeError(msg)
 
 
 def load(path, *, backend: str | None = None):
@@ -210,7 +223,7 @@ def load(path, *, backend: str | None = None):
             )
             events = arrays["events"]
         else:
-            scene_meta, settings, state, events = _first_layout(meta, arrays)
+            scene_meta, settings, state, events = _first_layout(engine, meta, arrays)
         if backend is not None or (settings.get("backend") == "numba" and not numba_available()):
             settings = {**settings, "backend": backend or "auto"}
         segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
@@ -236,14 +249,18 @@ def load(path, *, backend: str | None = None):
     return sim
 
 
-def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenState, np.ndarray]:
-    """``(scene, settings, state, events)`` from a file of the first layout (event-driven engines only).
+def _first_layout(engine: type, meta: dict, arrays: dict) -> tuple[dict, dict, EngineState, np.ndarray]:
+    """``(scene, settings, state, events)`` from a file of the first layout, for ``engine`` (the class the file
+    names: that layout held event-driven engines only, and ``EventDriven`` reads it).
 
     That layout stored the engine's private lists by attribute name, in its internal numbering (``order``;
     files older still used the caller's numbering throughout), and each queued event's payload as
     ``(kind, other, stamp)``. It kept no image counters: they are rebuilt from the log when it covers
     the whole run, and start from zero otherwise (``unwrapped_positions`` then count from the load).
     """
+    if engine.__name__ != "EventDriven":
+        msg = f"layout {meta.get('layout')!r} holds event-driven engines only, not {engine.__name__}"
+        raise CheckpointError(msg)
     old = dict(meta["state"])
     old.update({k.removeprefix("state."): v for k, v in arrays.items() if k.startswith("state.")})
     scalars, settings = old["scalars"], old["settings"]
@@ -266,8 +283,8 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
     last = scalars["last"]
     box = Box(**meta["box"])
     cell_size = settings["cell_size"]
-    grid = EventDriven.cell_grid(arrays["discs.radii"], box, cell_size)
-    state = EventDrivenState(
+    grid = engine.cell_grid(arrays["discs.radii"], box, cell_size)
+    state = engine.STATE(
         time=scalars["time"],
         epoch=scalars.get("epoch", 0.0),
         since_rebase=scalars.get("since_rebase", 0),
@@ -368,3 +385,6 @@ def resume(path, *, progress: bool = False, record_to=None, backend: str | None 
         checkpoint_every=run["checkpoint_every"],
     )
     return sim
+
+
+provide("save", save)

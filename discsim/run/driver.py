@@ -4,6 +4,9 @@ The driver checks the limits once ("no limit" is ``None``), asks the engine for 
 (``engine._advance``), and between chunks serves the observers: the progress bar, the event stream, the
 checkpointer and any user callback (:mod:`discsim.run.observers`). With no observer, a run is one call of
 the engine's loop. Chunks change nothing in the dynamics: the engine resumes exactly where it stopped.
+
+``Engine.run`` is :func:`run_engine`, handed down to the engines when this module is imported
+(:func:`discsim.engines.base.provide`): the engines never import the driver.
 """
 
 from __future__ import annotations
@@ -12,10 +15,12 @@ import math
 from dataclasses import dataclass
 
 from discsim._validate import check_count, check_until, is_count
+from discsim.engines.base import provide
 from discsim.errors import InvalidArgumentError, TimeError
+from discsim.run.handlers import EventHandlers
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 
-__all__ = ["RunPlan", "drive"]
+__all__ = ["RunPlan", "drive", "run_engine"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +55,35 @@ class RunPlan:
             "record_to": self.record_to,
             "finished": finished,
         }
+
+
+def run_engine(
+    engine,
+    until=None,
+    *,
+    events=None,
+    observers=(),
+    progress: bool = False,
+    record_to=None,
+    checkpoint=None,
+    checkpoint_every=None,
+) -> int:
+    """``engine.run(...)``: :func:`drive`, with the engine's ``sim.on(...)`` callbacks as one more observer.
+
+    Returns the units of work done.
+    """
+    if engine._handlers:  # sim.on(...): one event (or frame) at a time, callbacks after each
+        observers = [*(observers or ()), EventHandlers(engine._handlers)]
+    return drive(
+        engine,
+        until=until,
+        limit=events,
+        observers=observers,
+        progress=progress,
+        record_to=record_to,
+        checkpoint=checkpoint,
+        checkpoint_every=checkpoint_every,
+    )
 
 
 def drive(
@@ -222,3 +256,6 @@ def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], str
         for observer in reversed(started):
             observer.finish(engine, completed)
     return done
+
+
+provide("run", run_engine)

@@ -36,7 +36,7 @@ from discsim._interrupt import deferred_interrupt
 from discsim._numba import resolve_backend
 from discsim._validate import check_count, positive_finite
 from discsim.cells import CellGrid
-from discsim.engines.base import Engine
+from discsim.engines.base import Engine, register_engine
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BROAD_PHASE_CLASSES
 from discsim.engines.fixed_step.frame import FRAME_POLICY_CLASSES
@@ -67,6 +67,7 @@ DEFAULT_FRAME_RATE = 30.0
 DEFAULT_BISECT_FRACTION = 1e-6
 
 
+@register_engine
 class FixedStep(Engine):
     """Fixed-step simulation with a periodic interference test (PIT).
 

@@ -1,4 +1,4 @@
-"""The layers of docs/architecture.md hold: module-level imports point down (or sideways), never up."""
+"""The layers of docs/architecture.md hold: imports point down (or sideways), never up, inside functions too."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from paths import PACKAGE
 
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
-    "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled"],
+    "ground": ["model", "kernels", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled", "_progress"],
     "model": ["scene", "scenarios", "events", "trajectory", "cells", "repair"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "view", "__init__", "__main__"],
@@ -29,6 +29,33 @@ def _modules():
         yield ".".join(parts[:-1] if parts[-1] == "__init__" else parts), path
 
 
+def _resolve(module: str, node: ast.ImportFrom) -> str | None:
+    """The absolute name a ``from ... import`` in ``module`` names (relative ones resolved); None outside discsim."""
+    if not node.level:
+        return node.module if node.module and node.module.split(".")[0] == "discsim" else None
+    package = module.split(".")  # a package's own name stands for its __init__, so go up one less
+    base = package[: len(package) - node.level + (1 if _is_package(module) else 0)]
+    return ".".join([*base, node.module] if node.module else base)
+
+
+def _is_package(module: str) -> bool:
+    return (PACKAGE.parent / Path(*module.split(".")) / "__init__.py").exists()
+
+
+def _all_imports(module: str, path: Path) -> list[tuple[str, int]]:
+    """Every discsim module ``module`` imports, anywhere in the file (inside functions and classes too), with
+    the line: the arrows point down inside functions as well."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            name = _resolve(module, node)
+            if name is not None:
+                found.append((name, node.lineno))
+        elif isinstance(node, ast.Import):
+            found += [(alias.name, node.lineno) for alias in node.names if alias.name.split(".")[0] == "discsim"]
+    return found
+
+
 def _top_level_imports(path: Path) -> list[str]:
     """discsim modules imported at module level (not inside functions: those are the documented late calls)."""
     tree = ast.parse(path.read_text())
@@ -39,6 +66,36 @@ def _top_level_imports(path: Path) -> list[str]:
         elif isinstance(node, ast.Import):
             found += [alias.name for alias in node.names if alias.name.startswith("discsim")]
     return found
+
+
+@pytest.mark.parametrize(("module", "path"), list(_modules()), ids=[m for m, _ in _modules()])
+def test_imports_point_down_inside_functions_too(module, path):
+    if module == "discsim":
+        return  # the package's front door re-exports every floor
+    up = [
+        f"line {line}: {imported} (floor {_floor(imported)})"
+        for imported, line in _all_imports(module, path)
+        if imported != "discsim" and _floor(imported) > _floor(module)
+    ]
+    assert not up, f"{module} (floor {_floor(module)}) imports from above: {up}"
+
+
+def test_the_import_reader_sees_late_and_relative_imports(tmp_path):
+    source = "def f():\n    from discsim.run.driver import drive\n    from . import state\n    import discsim.io\n"
+    (tmp_path / "m.py").write_text(source)
+    found = _all_imports("discsim.engines.event_driven.engine", tmp_path / "m.py")
+    assert found == [("discsim.run.driver", 2), ("discsim.engines.event_driven", 3), ("discsim.io", 4)]
+    assert [_floor(name) for name, _ in found] == [3, 2, 3]
+
+
+def test_checkpoints_name_no_engine_module():
+    """io/checkpoints.py finds engines in the registry (engines/base.py) and imports none of their modules."""
+    imported = [name for name, _ in _all_imports("discsim.io.checkpoints", PACKAGE / "io" / "checkpoints.py")]
+    engines = [name for name in imported if name.startswith("discsim.engines")]
+    assert engines == ["discsim.engines.base"]
+    text = (PACKAGE / "io" / "checkpoints.py").read_text()
+    for package in sorted(p.name for p in (PACKAGE / "engines").iterdir() if (p / "__init__.py").exists()):
+        assert f"discsim.engines.{package}" not in text
 
 
 @pytest.mark.parametrize(("module", "path"), list(_modules()), ids=[m for m, _ in _modules()])

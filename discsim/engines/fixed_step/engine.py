@@ -42,6 +42,7 @@ from discsim.engines.fixed_step.broad_phase import BROAD_PHASE_CLASSES
 from discsim.engines.fixed_step.frame import FRAME_POLICY_CLASSES
 from discsim.engines.fixed_step.state import FixedStepState
 from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisect
+from discsim.engines.record import collision_virials
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
 from discsim.model import Box, Discs, _readonly
@@ -329,8 +330,6 @@ class FixedStep(Engine):
         sim._edits = int(settings.get("edits", 0))
         if math.isnan(state.virial) and len(events) == state.detections + state.wall_hits + sim._edits:
             # A version 1 state (no virial) whose log holds the whole run: the virial is in the log.
-            from discsim.analysis.thermo import collision_virials
-
             state.virial = float(np.sum(collision_virials(events, scene.discs.masses, scene.box)[1]))
         sim._load(state)
         if len(events):

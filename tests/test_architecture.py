@@ -115,3 +115,28 @@ def test_the_container_format_knows_no_engine():
 def test_backends_know_no_front_class():
     for path in (PACKAGE / "engines" / "event_driven" / "python").glob("*.py"):
         assert "discsim.engines.event_driven.engine" not in _top_level_imports(path)
+
+
+#: Rooms still too big (issue 26, item 5: no module over 700 lines, no class over 400 in discsim/), to be split
+#: by their owners; anything else over the limits fails.
+TOO_BIG = {
+    "discsim/engines/event_driven/python/backend.py",  # 793 lines; PythonBackend 668
+    "discsim/engines/fixed_step/numba/sub_frame.py",  # 944 lines
+    "discsim/engines/fixed_step/numba/kernels.py",  # 708 lines
+    "discsim/engines/event_driven/numba/loop.py",  # 710 lines
+    "discsim/engines/event_driven/engine.py",  # EventDriven 428
+    "discsim/engines/fixed_step/engine.py",  # FixedStep 559
+}
+
+
+def test_small_rooms():
+    big = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = path.relative_to(PACKAGE.parent).as_posix()
+        source = path.read_text()
+        if len(source.splitlines()) > 700:
+            big.append(f"{name}: {len(source.splitlines())} lines")
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno + 1 > 400:
+                big.append(f"{name}: class {node.name} {node.end_lineno - node.lineno + 1} lines")
+    assert not [b for b in big if b.split(":")[0] not in TOO_BIG], big

@@ -1,16 +1,100 @@
-"""What every engine reads from its event log: the log kept in memory and what is rebuilt from it.
+"""What every engine reads from its event log: :class:`EventRecord` (``events``, the exact ``trajectory``) and
+:func:`collision_virials`.
 
-Numbers from the records only, so that an engine restoring an old checkpoint (``FixedStep``'s version 1
-state) and the analyses above (:mod:`discsim.analysis.thermo`) share one definition.
+:class:`EventRecord` is a mixin of :class:`~discsim.engines.base.Engine`: it reads the engine's log
+(``_log``, an :class:`~discsim.events.EventLog` its loop fills while ``_logging``), its ``record`` setting,
+its clock and the discs where the log starts. :func:`collision_virials` takes records only, so that an
+engine restoring an old checkpoint (``FixedStep``'s version 1 state) and the analyses above
+(:mod:`discsim.analysis.thermo`) share one definition.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from discsim.events import COLLISION
+from discsim.errors import InvalidArgumentError
+from discsim.events import COLLISION, EVENT_DTYPE
+from discsim.model import Discs
+from discsim.trajectory import positions_from_log
 
-__all__ = ["collision_virials"]
+__all__ = ["EventRecord", "collision_virials"]
+
+
+class EventRecord:
+    """The event log's readers every engine shares (see the module docstring)."""
+
+    @property
+    def _logging(self) -> bool:
+        """Whether the loop logs events now: ``record``, or an observer of the current run wants them."""
+        return self.record or self._recording
+
+    def _log_origin(self) -> tuple[Discs, np.ndarray | None]:
+        """``(discs, ids)`` where the log starts, at ``start_time`` (ids None: their indices)."""
+        return (self.discs, None) if self._origin is None else self._origin
+
+    @property
+    def events(self) -> np.ndarray:
+        """The recorded event log: a structured array ``(E,)`` of :data:`~discsim.events.EVENT_DTYPE`.
+
+        Empty when the engine was built with ``record=False``.
+
+        Raises:
+            InvalidArgumentError: if the log was streamed to disk (``run(record_to=...)``):
+                read it with :func:`discsim.read_events`.
+        """
+        self._refuse_if_streamed("events")
+        if not self.record:
+            return np.zeros(0, dtype=EVENT_DTYPE)
+        return self._log.to_array()
+
+    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
+        """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log.
+
+        Column ``k`` is the disc of id ``k`` (:attr:`ids`): the disc of index ``k`` unless discs were
+        removed. After :meth:`add_discs` or :meth:`remove_discs` there is one column per disc the run ever
+        held (``M >= N``: ``trajectory(t)[:, sim.ids]`` are the discs there now), NaN at times the disc was
+        not there (before its ``ADD`` record, from its ``REMOVE`` record on). After such a change the engine
+        restarts every disc's path from where it is, so positions rebuilt between that change and a
+        disc's next event may differ from the engine's own in the last bits.
+
+        Args:
+            times: simulated times within ``[start_time, time]``, any order.
+            unwrapped: in a periodic box, follow each disc across the edges
+                instead of wrapping it into the box (as a mean-squared
+                displacement needs); the same as wrapped in a walled box.
+
+        Raises:
+            InvalidArgumentError: if the engine does not hold its log
+                (``record=False``, or streamed to disk: use
+                :func:`discsim.trajectory_from_events`).
+            TimeError: if a time is not finite or lies outside the simulated span.
+        """
+        self._refuse_if_streamed("trajectory()")
+        if not self.record:
+            msg = "trajectory() needs the event log; build the engine with record=True"
+            raise InvalidArgumentError(msg)
+        discs, ids = self._log_origin()
+        return positions_from_log(
+            self._log.to_array(),
+            discs,
+            self.box,
+            self.start_time,
+            self.time,
+            times,
+            span="simulated span",
+            unwrapped=unwrapped,
+            ids=ids,
+        )
+
+    def _refuse_if_streamed(self, what: str) -> None:
+        if self._stream is not None:
+            path = self._stream["path"]
+            msg = (
+                f"{what} is not kept in memory: this run streamed its event log to {path!r}; "
+                f"read it with ds.read_events({path!r}) and rebuild positions with "
+                f"ds.trajectory_from_events({path!r}, times)"
+            )
+            raise InvalidArgumentError(msg)
 
 
 def collision_virials(events: np.ndarray, masses: np.ndarray, box) -> tuple[np.ndarray, np.ndarray]:

@@ -363,8 +363,8 @@ class FixedStep(Engine):
     def _advance(self, until: float, limit: int | None) -> int:
         todo = self._frames_due(until)
         if limit is not None:
-            todo = min(todo, limit)
-        if todo == math.inf:
+            todo = limit if todo is None else min(todo, limit)
+        if todo is None:
             msg = "a fixed-step run needs a finite until or a frame count"
             raise InvalidArgumentError(msg)
         done = 0
@@ -383,13 +383,14 @@ class FixedStep(Engine):
                     done += count
         return todo
 
-    def _frames_due(self, until: float) -> float:
-        """Frames still to do up to time ``until`` (inf for ``until=inf``), allowing for the roundoff of ``k * dt``.
+    def _frames_due(self, until: float) -> int | None:
+        """Frames still to do up to time ``until``, allowing for the roundoff of ``k * dt``; None (no count) for
+        ``until = inf``.
 
         Counted from the start, so that a run gives the same frames however it is cut into calls.
         """
         if until == math.inf:
-            return math.inf
+            return None
         last = math.floor((until - self.start_time) / self.dt * (1 + 1e-12) + 1e-9)
         return max(0, last - self.frames)
 

@@ -140,3 +140,35 @@ def test_small_rooms():
             if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno + 1 > 400:
                 big.append(f"{name}: class {node.name} {node.end_lineno - node.lineno + 1} lines")
     assert not [b for b in big if b.split(":")[0] not in TOO_BIG], big
+
+
+#: An engine's run bookkeeping, read and changed above the engines only through ``engine.run_context``.
+BOOKKEEPING = {
+    "_log", "_stream", "_run_id", "_recording", "_structure", "_origin", "_ids", "_next_id", "_handlers",
+    "_log_origin", "_new_discs",
+}  # fmt: skip
+
+
+def _reaches_into(path: Path) -> list[str]:
+    """``x._name`` (x not ``self``) and ``getattr(x, "_name")`` for the bookkeeping names, with their lines."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Attribute) and node.attr in BOOKKEEPING:
+            if not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls")):
+                found.append(f"line {node.lineno}: .{node.attr}")
+        elif isinstance(node, ast.Call) and getattr(node.func, "id", None) in ("getattr", "hasattr", "setattr"):
+            names = [a.value for a in node.args[1:2] if isinstance(a, ast.Constant)]
+            found += [f"line {node.lineno}: {node.func.id} {name!r}" for name in names if name in BOOKKEEPING]
+    return found
+
+
+@pytest.mark.parametrize("folder", ["run", "io", "analysis", "view.py", "plot.py"])
+def test_the_layers_above_use_the_run_context_not_the_engines_privates(folder):
+    paths = [PACKAGE / folder] if folder.endswith(".py") else sorted((PACKAGE / folder).rglob("*.py"))
+    found = {str(path.relative_to(PACKAGE)): _reaches_into(path) for path in paths}
+    assert not {name: lines for name, lines in found.items() if lines}
+
+
+def test_the_privates_reader_sees_a_reach(tmp_path):
+    (tmp_path / "m.py").write_text("def f(sim):\n    sim._stream = None\n    return getattr(sim, '_origin')\n")
+    assert _reaches_into(tmp_path / "m.py") == ["line 2: ._stream", "line 3: getattr '_origin'"]

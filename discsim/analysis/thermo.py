@@ -228,7 +228,7 @@ def thermo(source, since: float | None = None, blocks: int = 10) -> ThermoAverag
         return _from_blocks(fine, since, blocks)
     from discsim.analysis.frames import log_source
 
-    engine = source if hasattr(source, "_log") else None
+    engine = source if hasattr(source, "run_context") else None
     if engine is not None:
         _check_pressure_engine(engine, "thermo()")
     chunks, discs, box, start, end, sim = log_source(source, "thermo()")

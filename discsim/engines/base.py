@@ -19,6 +19,9 @@ implements three small protocols, all here as abstract methods:
 The rest is written once, so ``compare``, ``plot``, notebooks and benchmarks work with any engine and
 backend: ``run``, ``save``, ``snapshot``, energies and momentum here, disc editing in
 :mod:`~discsim.engines.editing`, ``events`` and the exact ``trajectory`` in :mod:`~discsim.engines.record`.
+The run's bookkeeping (the log in memory, the run id and streamed log, the disc ids, the callbacks) is
+``engine.run_context`` (:class:`~discsim.engines.context.RunContext`): the layers above use that, not the
+engine's private attributes.
 
 Two tables join the engines to the layers above without an import pointing up, not even inside a function:
 
@@ -42,10 +45,10 @@ from typing import ClassVar
 
 import numpy as np
 
+from discsim.engines.context import RunContext
 from discsim.engines.editing import DiscEditing
 from discsim.engines.record import EventRecord
 from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError, WrongTypeError
-from discsim.events import EventLog
 from discsim.model import Box, Discs, kinetic_energy, momentum
 from discsim.repair import Repair, restart_scene
 from discsim.scene import Scene
@@ -185,19 +188,11 @@ class Engine(DiscEditing, EventRecord, ABC):
             raise InvalidArgumentError(msg)
         self.record = bool(record)
         self.start_time = 0.0
-        self._log = EventLog()
-        self._recording = False  # the driver records for its observers meanwhile, whatever ``record`` says
+        #: The run's bookkeeping (:class:`~discsim.engines.context.RunContext`): the log in memory, the run id
+        #: and streamed log, the disc ids, the callbacks. The driver, ``io`` and ``analysis`` use it.
+        self.run_context = RunContext(len(scene))
         self._broken: str | None = None  # why the engine cannot go on (an exception inside its loop)
-        self._run_id: str | None = None  # identifies this run in its checkpoints and streamed log
-        self._stream: dict | None = None  # this run's log on disk: path, run_id, base, records, end
         self._edits = 0  # discs changed by the user (one SET record each in a recorded log)
-        self._handlers: dict[str, list] = {}  # sim.on(kind, fn): callbacks after each event of that kind
-        # Disc ids (add_discs, remove_discs): the log names discs by id; None while ids are the indices.
-        self._ids: np.ndarray | None = None  # (N,) each disc's id
-        self._next_id = len(scene)  # the id the next disc added gets
-        self._origin: tuple[Discs, np.ndarray | None] | None = None  # (discs, ids) where the log starts, once
-        # the discs changed (``discs`` is then the current scene); None: (``discs``, their indices)
-        self._structure = 0  # add_discs / remove_discs calls so far (observers notice the disc set changed)
 
     # --- the driver's protocol ---------------------------------------------------------
     @abstractmethod

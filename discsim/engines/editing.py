@@ -14,6 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from discsim.engines.context import readonly_ids
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Discs
 from discsim.scene import Scene, check_added
@@ -143,12 +144,13 @@ class DiscEditing:
         scene = self.scene
         check_added(everyone, self.box, n, scene.segments, scene.pass_through)
         new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, check=False)
-        ids = np.arange(self._next_id, self._next_id + k, dtype=np.int64)
+        context = self.run_context
+        ids = np.arange(context.next_id, context.next_id + k, dtype=np.int64)
         ids_after, origin = np.concatenate([self.ids, ids]), self._log_origin()
         self._restructure(np.arange(n), discs, new_scene)
-        self._new_discs(new_scene, ids_after, self._next_id + k, origin)
-        if self._logging or self._stream is not None:
-            self._log.add(self.time, ids, discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups)
+        self._new_discs(new_scene, ids_after, context.next_id + k, origin)
+        if self._logging or context.streamed:
+            context.log.add(self.time, ids, discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups)
         self._edits += k
         return np.arange(n, n + k, dtype=np.int64)
 
@@ -187,23 +189,20 @@ class DiscEditing:
         new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
         gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()
         self._restructure(keep, None, new_scene)
-        self._new_discs(new_scene, ids_after, self._next_id, origin)
-        if self._logging or self._stream is not None:
-            self._log.remove(self.time, gone, gone_positions, gone_velocities)
+        self._new_discs(new_scene, ids_after, self.run_context.next_id, origin)
+        if self._logging or self.run_context.streamed:
+            self.run_context.log.remove(self.time, gone, gone_positions, gone_velocities)
         self._edits += len(idx)
         return self
 
     def _new_discs(self, scene: Scene, ids: np.ndarray, next_id: int, origin: tuple) -> None:
         """After :meth:`_restructure`: the new scene and ids (the log's rows so far renamed by the old ones), and
         ``origin``, the discs where the log starts (:meth:`_log_origin` before the change)."""
-        self._origin = origin
-        self._log.flush()
+        context = self.run_context
+        context.log.flush()
         self.scene, self.discs = scene, scene.discs
-        identity = bool(np.array_equal(ids, np.arange(len(ids))))
-        self._ids = None if identity else _readonly_ids(ids)
-        self._next_id = int(next_id)
-        self._log.ids = self._ids
-        self._structure += 1
+        context.set_ids(ids, next_id, origin)
+        context.structure += 1
 
     @property
     def ids(self) -> np.ndarray:
@@ -212,9 +211,18 @@ class DiscEditing:
         A disc's id is its index until some disc is removed (:meth:`remove_discs`): indices then shift down
         while ids never change; a disc added later gets the next id never used.
         """
-        if self._ids is None:
-            return _readonly_ids(np.arange(len(self.discs), dtype=np.int64))
-        return self._ids
+        ids = self.run_context.ids
+        return readonly_ids(np.arange(len(self.discs), dtype=np.int64)) if ids is None else ids
+
+    @property
+    def _origin(self) -> tuple[Discs, np.ndarray | None] | None:
+        """``run_context.origin`` (read-only here)."""
+        return self.run_context.origin
+
+    @property
+    def _next_id(self) -> int:
+        """``run_context.next_id`` (read-only here)."""
+        return self.run_context.next_id
 
     def on(self, kind: str, fn):
         """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"`` or ``"segment"``).
@@ -234,7 +242,7 @@ class DiscEditing:
         if not callable(fn):
             msg = f"on({kind!r}, fn) needs a callable fn(sim, contact), got {type(fn).__name__}"
             raise InvalidArgumentError(msg)
-        self._handlers.setdefault(kind, []).append(fn)
+        self.run_context.handlers.setdefault(kind, []).append(fn)
         return self
 
     def _disc_indices(self, indices) -> np.ndarray:
@@ -306,10 +314,10 @@ class DiscEditing:
         if len(idx):
             self._set_discs(idx, positions, velocities)
         self._edits += len(idx)
-        if (self._logging or self._stream is not None) and len(idx):  # a streamed log takes it at the next run
+        if (self._logging or self.run_context.streamed) and len(idx):  # a streamed log takes it at the next run
             t, pos, vel, ids = self.time, self.positions[idx], self.velocities[idx], self.ids[idx]
             for k, i in enumerate(ids.tolist()):
-                self._log.set(t, i, pos[k, 0], pos[k, 1], vel[k, 0], vel[k, 1])
+                self.run_context.log.set(t, i, pos[k, 0], pos[k, 1], vel[k, 0], vel[k, 1])
 
     def _check_places(self, idx: np.ndarray, positions: np.ndarray) -> None:
         """Refuse positions outside the box, cut by a wall or a segment, or overlapping another disc."""
@@ -351,9 +359,3 @@ class DiscEditing:
                     f"(distance {dist[j]:.6g}, contact distance {contact[j]:.6g})"
                 )
                 raise OverlapError(msg)
-
-
-def _readonly_ids(ids: np.ndarray) -> np.ndarray:
-    out = np.array(ids, dtype=np.int64)
-    out.flags.writeable = False
-    return out

@@ -2,7 +2,7 @@
 :func:`collision_virials`.
 
 :class:`EventRecord` is a mixin of :class:`~discsim.engines.base.Engine`: it reads the engine's log
-(``_log``, an :class:`~discsim.events.EventLog` its loop fills while ``_logging``), its ``record`` setting,
+(``run_context.log``, an :class:`~discsim.events.EventLog` its loop fills while ``_logging``), its ``record`` setting,
 its clock and the discs where the log starts. :func:`collision_virials` takes records only, so that an
 engine restoring an old checkpoint (``FixedStep``'s version 1 state) and the analyses above
 (:mod:`discsim.analysis.thermo`) share one definition.
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION, EVENT_DTYPE
+from discsim.events import COLLISION, EVENT_DTYPE, EventLog
 from discsim.model import Discs
 from discsim.trajectory import positions_from_log
 
@@ -26,11 +26,16 @@ class EventRecord:
     @property
     def _logging(self) -> bool:
         """Whether the loop logs events now: ``record``, or an observer of the current run wants them."""
-        return self.record or self._recording
+        return self.record or self.run_context.recording
+
+    @property
+    def _log(self) -> EventLog:
+        """The log in memory, ``run_context.log``, as the engines' loops fill it."""
+        return self.run_context.log
 
     def _log_origin(self) -> tuple[Discs, np.ndarray | None]:
         """``(discs, ids)`` where the log starts, at ``start_time`` (ids None: their indices)."""
-        return (self.discs, None) if self._origin is None else self._origin
+        return self.run_context.log_origin(self.discs)
 
     @property
     def events(self) -> np.ndarray:
@@ -45,7 +50,7 @@ class EventRecord:
         self._refuse_if_streamed("events")
         if not self.record:
             return np.zeros(0, dtype=EVENT_DTYPE)
-        return self._log.to_array()
+        return self.run_context.log.to_array()
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log.
@@ -75,7 +80,7 @@ class EventRecord:
             raise InvalidArgumentError(msg)
         discs, ids = self._log_origin()
         return positions_from_log(
-            self._log.to_array(),
+            self.run_context.log.to_array(),
             discs,
             self.box,
             self.start_time,
@@ -87,8 +92,9 @@ class EventRecord:
         )
 
     def _refuse_if_streamed(self, what: str) -> None:
-        if self._stream is not None:
-            path = self._stream["path"]
+        stream = self.run_context.stream
+        if stream is not None:
+            path = stream["path"]
             msg = (
                 f"{what} is not kept in memory: this run streamed its event log to {path!r}; "
                 f"read it with ds.read_events({path!r}) and rebuild positions with "

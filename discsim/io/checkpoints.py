@@ -26,7 +26,6 @@ This module imports no engine: it finds the class a file names in the registry
 
 from __future__ import annotations
 
-import uuid
 import warnings
 from pathlib import Path
 
@@ -62,14 +61,14 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         run: the goal of the ``run()`` call writing it (see :func:`checkpoint_info`), or None for ``save()``.
         record: the engine's own ``record`` setting (a streaming run records meanwhile).
     """
-    if engine._run_id is None:
-        engine._run_id = uuid.uuid4().hex
+    context = engine.run_context
+    run_id = context.ensure_run_id()
     scalars, arrays = engine.state().to_arrays()
     discs, box, scene = engine.discs, engine.box, engine.scene
     meta = {
         "layout": LAYOUT,
         "engine": type(engine).__name__,
-        "run_id": engine._run_id,
+        "run_id": run_id,
         "start_time": engine.start_time,
         "time": engine.time,
         "counts": dict(engine.counts),
@@ -81,19 +80,19 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         "settings": {**engine._settings(), "record": record},
         "state_version": engine.STATE.VERSION,
         "state": scalars,
-        "stream": engine._stream,
+        "stream": context.stream,
         "run": run,
     }
     out = {f"state.{name}": value for name, value in arrays.items()}
-    out["events"] = engine._log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
+    out["events"] = context.log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
     out.update(_discs_arrays("discs", discs))
-    if engine._origin is not None:  # the discs changed (add_discs, remove_discs): discs.* are today's scene
-        origin, origin_ids = engine._origin
+    if context.origin is not None:  # the discs changed (add_discs, remove_discs): discs.* are today's scene
+        origin, origin_ids = context.origin
         out.update(_discs_arrays("origin", origin))
         if origin_ids is not None:
             out["origin.ids"] = np.asarray(origin_ids, dtype=np.int64)
         out["ids"] = np.asarray(engine.ids, dtype=np.int64)
-        meta["next_id"] = engine._next_id
+        meta["next_id"] = context.next_id
     return write_state(Path(path), meta, out)
 
 
@@ -239,13 +238,13 @@ def load(path, *, backend: str | None = None):
                 msg = f"ids of shape {ids.shape} for {len(discs)} discs"
                 raise ValueError(msg)
             origin_ids = arrays.get("origin.ids")
-            sim._new_discs(scene, ids, int(meta["next_id"]), (_discs_from(arrays, "origin"), origin_ids))
-            sim._structure = 0
+            sim.run_context.log.flush()
+            sim.run_context.set_ids(ids, int(meta["next_id"]), (_discs_from(arrays, "origin"), origin_ids))
     except (KeyError, TypeError, IndexError, ValueError, DiscsimError) as exc:
         msg = f"{path}: the checkpoint is incomplete or inconsistent ({type(exc).__name__}: {exc})"
         raise CheckpointError(msg) from exc
-    sim._run_id = meta["run_id"]
-    sim._stream = meta["stream"]
+    sim.run_context.run_id = meta["run_id"]
+    sim.run_context.stream = meta["stream"]
     return sim
 
 

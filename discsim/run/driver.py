@@ -81,8 +81,9 @@ def run_engine(
 
     Returns the units of work done.
     """
-    if engine._handlers:  # sim.on(...): one event (or frame) at a time, callbacks after each
-        observers = [*(observers or ()), EventHandlers(engine._handlers)]
+    handlers = engine.run_context.handlers
+    if handlers:  # sim.on(...): one event (or frame) at a time, callbacks after each
+        observers = [*(observers or ()), EventHandlers(handlers)]
     return drive(
         engine,
         until=until,
@@ -230,13 +231,14 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
         observer.check(engine, plan)
     wants_events = any(observer.wants_events for observer in chain)
     keep = engine.record and stream is None  # the log stays in memory (else the stream takes it)
-    log = engine._log
-    before = (engine._stream, engine._run_id)
+    context = engine.run_context
+    log = context.log
+    before = (context.stream, context.run_id)
     started: list[Observer] = []
     done = 0
     completed = False
     try:
-        engine._recording = wants_events  # the loop logs for the observers, whatever record says
+        context.recording = wants_events  # the loop logs for the observers, whatever record says
         try:
             for observer in chain:
                 observer.start(engine, plan)
@@ -245,7 +247,7 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
             for observer in reversed(started):  # nothing has run: leave no file and no trace behind
                 observer.finish(engine, False)
                 observer.undo_start()
-            engine._stream, engine._run_id = before
+            context.stream, context.run_id = before
             started = []
             raise
         if not keep:
@@ -276,7 +278,7 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
                 break
         completed = True
     finally:
-        engine._recording = False
+        context.recording = False
         for observer in reversed(started):
             observer.finish(engine, completed)
     return done

@@ -68,16 +68,20 @@ def register_engine(cls: type[Engine]) -> type[Engine]:
 
     Raises:
         WrongTypeError: if ``cls`` is not a subclass of :class:`Engine`.
-        InvalidArgumentError: if another class is registered under the same name.
+        InvalidArgumentError: if a class from another module (or of another qualified name) is registered
+            under the same name.
     """
     if not (isinstance(cls, type) and issubclass(cls, Engine)):
         msg = f"register_engine needs a subclass of discsim.engines.base.Engine, got {cls!r}"
         raise WrongTypeError(msg)
     known = _ENGINES.get(cls.__name__)
-    if known is not None and (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
+    if known is None:
+        _ENGINES[cls.__name__] = cls
+    elif (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
         msg = f"an engine named {cls.__name__!r} is registered already ({known.__module__}.{known.__qualname__})"
         raise InvalidArgumentError(msg)
-    _ENGINES[cls.__name__] = cls
+    # The same class, or its file run again (a second copy of the module, as pytest's importlib mode makes):
+    # the first stays, the one ``discsim.EventDriven`` and the like name.
     return cls
 
 

@@ -176,6 +176,8 @@ class Engine(DiscEditing, EventRecord, ABC):
     progress_chunk: ClassVar[int] = 20_000
     #: Events per chunk of a log streamed by ``run(record_to=...)``; at most this many are held in memory.
     stream_chunk: int = 16_384
+    #: The class of the engine's run state (each engine sets it).
+    STATE: ClassVar[type[EngineState]]
 
     discs: Discs
     box: Box

@@ -10,13 +10,13 @@ and counted. A mixin of :class:`~discsim.engines.base.Engine`: it reads the engi
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from discsim.engines.context import readonly_ids
+from discsim.engines.context import RunContext, readonly_ids
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
-from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Discs
+from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs
 from discsim.scene import Scene, check_added
 
 __all__ = ["DiscEditing"]
@@ -24,6 +24,28 @@ __all__ = ["DiscEditing"]
 
 class DiscEditing:
     """The disc-editing methods every engine shares (see the module docstring)."""
+
+    # What the engine gives these methods (declared for type checkers; Engine sets or defines each).
+    scene: Scene
+    discs: Discs
+    box: Box
+    segments: tuple
+    time: float
+    run_context: RunContext
+    _edits: int
+    _logging: bool
+
+    if TYPE_CHECKING:
+
+        @property
+        def positions(self) -> np.ndarray: ...
+        @property
+        def velocities(self) -> np.ndarray: ...
+        def snapshot(self) -> Discs: ...
+        def _check_usable(self) -> None: ...
+        def _log_origin(self) -> tuple[Discs, np.ndarray | None]: ...
+        def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None: ...
+        def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None: ...
 
     #: Event kinds a callback can follow with :meth:`on`.
     CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment")

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from discsim.engines.context import RunContext
 from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION, EVENT_DTYPE, EventLog
-from discsim.model import Discs
+from discsim.model import Box, Discs
 from discsim.trajectory import positions_from_log
 
 __all__ = ["EventRecord", "collision_virials"]
@@ -22,6 +23,14 @@ __all__ = ["EventRecord", "collision_virials"]
 
 class EventRecord:
     """The event log's readers every engine shares (see the module docstring)."""
+
+    # What the engine gives these methods (declared for type checkers; Engine sets or defines each).
+    discs: Discs
+    box: Box
+    record: bool
+    start_time: float
+    time: float
+    run_context: RunContext
 
     @property
     def _logging(self) -> bool:

@@ -28,12 +28,13 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from discsim._numba import available as numba_available
 from discsim._numba import resolve_backend
-from discsim.engines.base import EngineState, provide, registered_engines
+from discsim.engines.base import Engine, EngineState, provide, registered_engines
 from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
@@ -156,7 +157,7 @@ def checkpoint_info(path) -> dict:
         raise CheckpointError(msg) from exc
 
 
-def _engine_class(meta, path) -> type:
+def _engine_class(meta, path) -> type[Engine]:
     engine = meta.get("engine") if isinstance(meta, dict) else None
     engines = registered_engines()
     if not isinstance(engine, str) or engine not in engines:
@@ -248,7 +249,7 @@ def load(path, *, backend: str | None = None):
     return sim
 
 
-def _first_layout(engine: type, meta: dict, arrays: dict) -> tuple[dict, dict, EngineState, np.ndarray]:
+def _first_layout(engine: Any, meta: dict, arrays: dict) -> tuple[dict, dict, EngineState, np.ndarray]:
     """``(scene, settings, state, events)`` from a file of the first layout, for ``engine`` (the class the file
     names: that layout held event-driven engines only, and ``EventDriven`` reads it).
 

@@ -197,6 +197,7 @@ class Engine(DiscEditing, EventRecord, ABC):
         #: The run's bookkeeping (:class:`~discsim.engines.context.RunContext`): the log in memory, the run id
         #: and streamed log, the disc ids, the callbacks. The driver, ``io`` and ``analysis`` use it.
         self.run_context = RunContext(len(scene))
+        self._log = self.run_context.log  # the same object, for the loops (an attribute: step() reads it each call)
         self._broken: str | None = None  # why the engine cannot go on (an exception inside its loop)
         self._edits = 0  # discs changed by the user (one SET record each in a recorded log)
 

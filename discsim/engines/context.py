@@ -30,6 +30,7 @@ class RunContext:
     Attributes:
         log (EventLog): the records kept in memory: the engine's loop fills it while ``record`` or
             ``recording`` is on; the driver hands chunks of it to observers, a stream takes it to disk.
+            One object for the engine's life (its loops hold it as ``_log``): cleared, never replaced.
         recording (bool): the driver records for its observers now, whatever the engine's ``record`` says.
         run_id (str | None): identifies the run in its checkpoints and its streamed log (None until one
             is written: :meth:`ensure_run_id`).

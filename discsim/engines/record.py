@@ -2,10 +2,10 @@
 :func:`collision_virials`.
 
 :class:`EventRecord` is a mixin of :class:`~discsim.engines.base.Engine`: it reads the engine's log
-(``run_context.log``, an :class:`~discsim.events.EventLog` its loop fills while ``_logging``), its ``record`` setting,
-its clock and the discs where the log starts. :func:`collision_virials` takes records only, so that an
-engine restoring an old checkpoint (``FixedStep``'s version 1 state) and the analyses above
-(:mod:`discsim.analysis.thermo`) share one definition.
+(``run_context.log``, an :class:`~discsim.events.EventLog` its loop fills while ``_logging``), its
+``record`` setting, its clock and the discs where the log starts. :func:`collision_virials` takes records
+only, so that an engine restoring an old checkpoint (``FixedStep``'s version 1 state) and the analyses
+above (:mod:`discsim.analysis.thermo`) share one definition.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 
 from discsim.engines.context import RunContext
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION, EVENT_DTYPE, EventLog
+from discsim.events import COLLISION, EVENT_DTYPE
 from discsim.model import Box, Discs
 from discsim.trajectory import positions_from_log
 
@@ -36,11 +36,6 @@ class EventRecord:
     def _logging(self) -> bool:
         """Whether the loop logs events now: ``record``, or an observer of the current run wants them."""
         return self.record or self.run_context.recording
-
-    @property
-    def _log(self) -> EventLog:
-        """The log in memory, ``run_context.log``, as the engines' loops fill it."""
-        return self.run_context.log
 
     def _log_origin(self) -> tuple[Discs, np.ndarray | None]:
         """``(discs, ids)`` where the log starts, at ``start_time`` (ids None: their indices)."""

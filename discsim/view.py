@@ -82,7 +82,8 @@ class _Run:
 
 def _from_engine(sim, label: str | None) -> _Run:
     name = type(sim).__name__
-    stream = getattr(sim, "_stream", None)
+    context = getattr(sim, "run_context", None)
+    stream = None if context is None else context.stream
     if stream is not None:  # the run streamed its log to disk: replay the file, with the engine's scene
         from discsim.io.streams import read_events
 
@@ -171,7 +172,7 @@ def _from_path(path: Path, label: str | None) -> _Run:
     if not is_state:  # an event log (read_events names what else it may be)
         return _from_stream(read_events(path, partial=True), label or path.name)
     sim = load(path)  # a checkpoint: its log is in it, or was streamed to a file it names
-    stream = sim._stream
+    stream = sim.run_context.stream
     if stream is not None:
         log_path = Path(stream["path"])
         if not log_path.is_absolute() and not log_path.exists():

@@ -381,7 +381,8 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
             msg = f"compare() needs the event log of {name}; build the engine with record=True"
             raise InvalidArgumentError(msg)
     for run in (truth, approx):
-        if getattr(run, "_origin", None) is not None:
+        context = getattr(run, "run_context", None)
+        if context is not None and context.origin is not None:
             msg = (
                 f"compare() follows the same discs in both runs, and this {type(run).__name__} added or removed "
                 "discs (add_discs / remove_discs); compare runs started from the same discs instead"

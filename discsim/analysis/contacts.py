@@ -117,7 +117,8 @@ def contacts(source, discs=None, box=None, segments=()) -> Contacts:
     ids = None
     if hasattr(source, "events") and hasattr(source, "discs"):
         box, segments, events = source.box, source.segments, source.events
-        discs, ids = source._log_origin() if hasattr(source, "_log_origin") else (source.discs, None)
+        context = getattr(source, "run_context", None)
+        discs, ids = (source.discs, None) if context is None else context.log_origin(source.discs)
     else:
         events = np.asarray(source)
         if discs is None or box is None:

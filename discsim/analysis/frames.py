@@ -150,7 +150,7 @@ def log_source(source, what: str):
             set of discs, naming ``what``.
     """
     chunks, discs, box, start, end, sim = _log_source(source, what)
-    if sim is not None and sim._origin is not None:
+    if sim is not None and sim.run_context.origin is not None:
         raise InvalidArgumentError(_changed_message(what, None))
 
     def fixed():
@@ -181,12 +181,12 @@ def _log_source(source, what: str):
     if isinstance(source, StreamedEvents):
         log = source
         return (lambda: iter([log.events])), log.discs, log.box, log.start_time, log.end_time, None
-    if not hasattr(source, "_log") or not hasattr(source, "discs"):
+    if not hasattr(source, "run_context") or not hasattr(source, "discs"):
         msg = f"{what} needs an engine, a streamed event log or its path, got {type(source).__name__}"
         raise InvalidArgumentError(msg)
     sim = source
-    if sim._stream is not None:
-        path = sim._stream["path"]
+    if sim.run_context.streamed:
+        path = sim.run_context.stream["path"]
         header = next(iter_stream(path, partial=True))
         meta, arrays = header[0], header[1]
         discs = Discs(arrays["positions"], arrays["velocities"], arrays["radii"], arrays["masses"], arrays["groups"])
@@ -206,7 +206,7 @@ def _log_source(source, what: str):
             "with ds.Sampler(dt)"
         )
         raise InvalidArgumentError(msg)
-    return (lambda: iter([sim._log.to_array()])), sim.discs, sim.box, sim.start_time, sim.time, sim
+    return (lambda: iter([sim.run_context.log.to_array()])), sim.discs, sim.box, sim.start_time, sim.time, sim
 
 
 def frames(source, times) -> Frames:

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim._validate import is_count
+from discsim.engines.record import collision_virials
 from discsim.errors import InvalidArgumentError, TimeError
-from discsim.events import COLLISION
 
 __all__ = [
     "ThermoAverages",
@@ -72,30 +72,6 @@ def _check_pressure_engine(sim, what: str) -> None:
     if not callable(getattr(sim, "pressure", None)):
         msg = f"{what} needs an engine with pressure() (EventDriven or FixedStep), got {type(sim).__name__}"
         raise InvalidArgumentError(msg)
-
-
-def collision_virials(events: np.ndarray, masses: np.ndarray, box) -> tuple[np.ndarray, np.ndarray]:
-    """``(times, W)`` of the disc-disc collisions in ``events``: each collision's virial ``dp_i . (r_i - r_j)``.
-
-    From the state after the collision only: with ``mu`` the reduced mass (the finite one for an obstacle),
-    ``W = 2 mu (u_i - u_j) . (r_i - r_j)``, ``u`` the velocities after and ``r_i - r_j`` the minimum image.
-    Summed over a run, this is the engine's own virial (``pressure()``) to roundoff.
-
-    Args:
-        events: structured array ``(E,)`` of :data:`~discsim.events.EVENT_DTYPE`.
-        masses: ``(N,)`` the discs' masses. box: the box.
-
-    Returns:
-        ``(C,)`` times and ``(C,)`` virials (energy units) of the ``C`` collisions.
-    """
-    rows = events[events["kind"] == COLLISION]
-    mi = masses[rows["i"]]
-    mj = masses[rows["j"]]
-    with np.errstate(invalid="ignore"):
-        mu = np.where(np.isinf(mj), mi, np.where(np.isinf(mi), mj, mi * mj / (mi + mj)))
-    d = box.minimum_image(np.column_stack([rows["xi"] - rows["xj"], rows["yi"] - rows["yj"]]))
-    w = 2.0 * mu * ((rows["vxi"] - rows["vxj"]) * d[:, 0] + (rows["vyi"] - rows["vyj"]) * d[:, 1])
-    return rows["time"].astype(float), w
 
 
 @dataclass(frozen=True)
@@ -252,7 +228,7 @@ def thermo(source, since: float | None = None, blocks: int = 10) -> ThermoAverag
         return _from_blocks(fine, since, blocks)
     from discsim.analysis.frames import log_source
 
-    engine = source if hasattr(source, "_log") else None
+    engine = source if hasattr(source, "run_context") else None
     if engine is not None:
         _check_pressure_engine(engine, "thermo()")
     chunks, discs, box, start, end, sim = log_source(source, "thermo()")

@@ -18,19 +18,23 @@ Typical use::
     sim.run(until=1e4, record_to="run/events.dse", checkpoint="run/state.dsc", checkpoint_every=10**6)
     # ... killed at any moment; later, in a new process:
     sim = ds.resume("run/state.dsc")         # same final state, bit for bit
+
+This module imports no engine: it finds the class a file names in the registry
+(:func:`discsim.engines.base.engine_class`), where each engine adds itself, and it provides
+``Engine.save`` (:func:`save`) to the engines when imported (:func:`discsim.engines.base.provide`).
 """
 
 from __future__ import annotations
 
-import uuid
+import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from discsim._numba import available as numba_available
 from discsim._numba import resolve_backend
-from discsim.engines.event_driven import EventDriven, EventDrivenState
-from discsim.engines.fixed_step import FixedStep
+from discsim.engines.base import Engine, EngineState, provide, registered_engines
 from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
@@ -40,8 +44,6 @@ from discsim.trajectory import reconstruct
 
 __all__ = ["checkpoint_info", "load", "resume", "save", "write_checkpoint"]
 
-#: Engines a checkpoint can hold, by the name stored in the file.
-ENGINES = {"EventDriven": EventDriven, "FixedStep": FixedStep}
 #: The layout of the JSON document and the arrays written by this version.
 LAYOUT = 2
 
@@ -60,14 +62,14 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         run: the goal of the ``run()`` call writing it (see :func:`checkpoint_info`), or None for ``save()``.
         record: the engine's own ``record`` setting (a streaming run records meanwhile).
     """
-    if engine._run_id is None:
-        engine._run_id = uuid.uuid4().hex
+    context = engine.run_context
+    run_id = context.ensure_run_id()
     scalars, arrays = engine.state().to_arrays()
     discs, box, scene = engine.discs, engine.box, engine.scene
     meta = {
         "layout": LAYOUT,
         "engine": type(engine).__name__,
-        "run_id": engine._run_id,
+        "run_id": run_id,
         "start_time": engine.start_time,
         "time": engine.time,
         "counts": dict(engine.counts),
@@ -79,19 +81,19 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         "settings": {**engine._settings(), "record": record},
         "state_version": engine.STATE.VERSION,
         "state": scalars,
-        "stream": engine._stream,
+        "stream": context.stream,
         "run": run,
     }
     out = {f"state.{name}": value for name, value in arrays.items()}
-    out["events"] = engine._log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
+    out["events"] = context.log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
     out.update(_discs_arrays("discs", discs))
-    if engine._origin is not None:  # the discs changed (add_discs, remove_discs): discs.* are today's scene
-        origin, origin_ids = engine._origin
+    if context.origin is not None:  # the discs changed (add_discs, remove_discs): discs.* are today's scene
+        origin, origin_ids = context.origin
         out.update(_discs_arrays("origin", origin))
         if origin_ids is not None:
             out["origin.ids"] = np.asarray(origin_ids, dtype=np.int64)
         out["ids"] = np.asarray(engine.ids, dtype=np.int64)
-        meta["next_id"] = engine._next_id
+        meta["next_id"] = context.next_id
     return write_state(Path(path), meta, out)
 
 
@@ -155,12 +157,23 @@ def checkpoint_info(path) -> dict:
         raise CheckpointError(msg) from exc
 
 
-def _engine_class(meta, path) -> type:
+def _engine_class(meta, path) -> type[Engine]:
     engine = meta.get("engine") if isinstance(meta, dict) else None
-    if engine not in ENGINES:
-        msg = f"{path}: not a discsim checkpoint (engine {engine!r}; known: {sorted(ENGINES)})"
+    engines = registered_engines()
+    if not isinstance(engine, str) or engine not in engines:
+        msg = f"{path}: not a discsim checkpoint (engine {engine!r}; known: {sorted(engines)})"
         raise CheckpointError(msg)
-    return ENGINES[engine]
+    return engines[engine]
+
+
+def __getattr__(name: str):
+    """``ENGINES``, the old table of engines by name: now :func:`discsim.engines.base.registered_engines`."""
+    if name == "ENGINES":
+        msg = "discsim.io.checkpoints.ENGINES is deprecated: use discsim.engines.base.registered_engines()"
+        warnings.warn(msg, DeprecationWarning, stacklevel=2)
+        return registered_engines()
+    msg = f"module {__name__!r} has no attribute {name!r}"
+    raise AttributeError(msg)
 
 
 def load(path, *, backend: str | None = None):
@@ -210,7 +223,7 @@ def load(path, *, backend: str | None = None):
             )
             events = arrays["events"]
         else:
-            scene_meta, settings, state, events = _first_layout(meta, arrays)
+            scene_meta, settings, state, events = _first_layout(engine, meta, arrays)
         if backend is not None or (settings.get("backend") == "numba" and not numba_available()):
             settings = {**settings, "backend": backend or "auto"}
         segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
@@ -226,24 +239,28 @@ def load(path, *, backend: str | None = None):
                 msg = f"ids of shape {ids.shape} for {len(discs)} discs"
                 raise ValueError(msg)
             origin_ids = arrays.get("origin.ids")
-            sim._new_discs(scene, ids, int(meta["next_id"]), (_discs_from(arrays, "origin"), origin_ids))
-            sim._structure = 0
+            sim.run_context.log.flush()
+            sim.run_context.set_ids(ids, int(meta["next_id"]), (_discs_from(arrays, "origin"), origin_ids))
     except (KeyError, TypeError, IndexError, ValueError, DiscsimError) as exc:
         msg = f"{path}: the checkpoint is incomplete or inconsistent ({type(exc).__name__}: {exc})"
         raise CheckpointError(msg) from exc
-    sim._run_id = meta["run_id"]
-    sim._stream = meta["stream"]
+    sim.run_context.run_id = meta["run_id"]
+    sim.run_context.stream = meta["stream"]
     return sim
 
 
-def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenState, np.ndarray]:
-    """``(scene, settings, state, events)`` from a file of the first layout (event-driven engines only).
+def _first_layout(engine: Any, meta: dict, arrays: dict) -> tuple[dict, dict, EngineState, np.ndarray]:
+    """``(scene, settings, state, events)`` from a file of the first layout, for ``engine`` (the class the file
+    names: that layout held event-driven engines only, and ``EventDriven`` reads it).
 
     That layout stored the engine's private lists by attribute name, in its internal numbering (``order``;
     files older still used the caller's numbering throughout), and each queued event's payload as
     ``(kind, other, stamp)``. It kept no image counters: they are rebuilt from the log when it covers
     the whole run, and start from zero otherwise (``unwrapped_positions`` then count from the load).
     """
+    if engine.__name__ != "EventDriven":
+        msg = f"layout {meta.get('layout')!r} holds event-driven engines only, not {engine.__name__}"
+        raise CheckpointError(msg)
     old = dict(meta["state"])
     old.update({k.removeprefix("state."): v for k, v in arrays.items() if k.startswith("state.")})
     scalars, settings = old["scalars"], old["settings"]
@@ -266,8 +283,8 @@ def _first_layout(meta: dict, arrays: dict) -> tuple[dict, dict, EventDrivenStat
     last = scalars["last"]
     box = Box(**meta["box"])
     cell_size = settings["cell_size"]
-    grid = EventDriven.cell_grid(arrays["discs.radii"], box, cell_size)
-    state = EventDrivenState(
+    grid = engine.cell_grid(arrays["discs.radii"], box, cell_size)
+    state = engine.STATE(
         time=scalars["time"],
         epoch=scalars.get("epoch", 0.0),
         since_rebase=scalars.get("since_rebase", 0),
@@ -368,3 +385,6 @@ def resume(path, *, progress: bool = False, record_to=None, backend: str | None 
         checkpoint_every=run["checkpoint_every"],
     )
     return sim
+
+
+provide("save", save)

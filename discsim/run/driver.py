@@ -1,9 +1,16 @@
 """The one run driver: ``run(until=..., events=..., observers=[...])`` for every engine.
 
-The driver checks the limits once ("no limit" is ``None``), asks the engine for work in chunks
-(``engine._advance``), and between chunks serves the observers: the progress bar, the event stream, the
+The driver checks the limits once, asks the engine for work in chunks (``engine._advance``), and between
+chunks serves the observers: the progress bar, the event stream, the
 checkpointer and any user callback (:mod:`discsim.run.observers`). With no observer, a run is one call of
 the engine's loop. Chunks change nothing in the dynamics: the engine resumes exactly where it stopped.
+
+"No limit" has one spelling past the public edge (:func:`run_limits`): a stop time is a float, ``math.inf``
+for none, and a count is an int, ``None`` for none. That is what ``engine._advance(until, limit)`` gets;
+users (``run(until=None)``) and observers (:attr:`RunPlan.until`) see ``None`` for no stop time.
+
+``Engine.run`` is :func:`run_engine`, handed down to the engines when this module is imported
+(:func:`discsim.engines.base.provide`): the engines never import the driver.
 """
 
 from __future__ import annotations
@@ -12,10 +19,12 @@ import math
 from dataclasses import dataclass
 
 from discsim._validate import check_count, check_until, is_count
+from discsim.engines.base import provide
 from discsim.errors import InvalidArgumentError, TimeError
+from discsim.run.handlers import EventHandlers
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 
-__all__ = ["RunPlan", "drive"]
+__all__ = ["RunPlan", "drive", "run_engine", "run_limits"]
 
 
 @dataclass(frozen=True)
@@ -23,7 +32,7 @@ class RunPlan:
     """What a run was asked to do, as observers see it.
 
     Attributes:
-        until: stop time, or None. limit: units of work to do, or None.
+        until: stop time, or None (no stop time). limit: units of work to do, or None (no count).
         unit: what a unit is ("events" or "frames").
         start_time: the engine's time when the run started.
         start_units: units of work done before the run (``engine._units()``).
@@ -41,15 +50,50 @@ class RunPlan:
     checkpoint_every: int | None = None
     record_to: str | None = None
 
+    @property
+    def stop(self) -> float:
+        """The stop time as the engine takes it: ``until``, or ``math.inf`` for none."""
+        return math.inf if self.until is None else self.until
+
     def target(self, finished: bool) -> dict:
         """The run's goal as a checkpoint stores it: ``until``, total ``events``, ``finished``, ..."""
         return {
-            "until": None if self.until in (None, math.inf) else self.until,
+            "until": self.until,
             "events": None if self.limit is None else self.start_units + self.limit,
             "checkpoint_every": self.checkpoint_every,
             "record_to": self.record_to,
             "finished": finished,
         }
+
+
+def run_engine(
+    engine,
+    until=None,
+    *,
+    events=None,
+    observers=(),
+    progress: bool = False,
+    record_to=None,
+    checkpoint=None,
+    checkpoint_every=None,
+) -> int:
+    """``engine.run(...)``: :func:`drive`, with the engine's ``sim.on(...)`` callbacks as one more observer.
+
+    Returns the units of work done.
+    """
+    handlers = engine.run_context.handlers
+    if handlers:  # sim.on(...): one event (or frame) at a time, callbacks after each
+        observers = [*(observers or ()), EventHandlers(handlers)]
+    return drive(
+        engine,
+        until=until,
+        limit=events,
+        observers=observers,
+        progress=progress,
+        record_to=record_to,
+        checkpoint=checkpoint,
+        checkpoint_every=checkpoint_every,
+    )
 
 
 def drive(
@@ -87,34 +131,24 @@ def drive(
     """
     engine._check_usable()
     unit = engine.unit
-    until = check_until(until, engine.time)
+    stop, limit = run_limits(until, limit, engine.time, unit)
     if checkpoint_every is not None and (not is_count(checkpoint_every) or checkpoint_every == 0):
         msg = f"checkpoint_every must be a positive integer ({unit}), got {checkpoint_every!r}"
         raise InvalidArgumentError(msg)
-    limit = check_count(unit, limit)
-    if until is None and limit is None:
-        msg = f"run() needs until=... or {unit}=..."
-        raise InvalidArgumentError(msg)
-    if until == math.inf:
-        if limit is None:
-            msg = f"run(until=inf) never ends: give a finite until or {unit}=..."
-            raise TimeError(msg)
-        until = None  # a count alone bounds the run: None is the one spelling of no limit
     every = None if checkpoint_every is None else int(checkpoint_every)
     if every is not None and checkpoint is None:
         msg = "checkpoint_every needs checkpoint=path"
         raise InvalidArgumentError(msg)
-    stop = math.inf if until is None else until
     chain = _observers(observers, progress, record_to, checkpoint, every)
     if not chain:
         done = engine._advance(stop, limit)
-        if until is not None and done != limit:  # stopped by the clock, not by the count
-            engine._settle(until)
+        if stop != math.inf and done != limit:  # stopped by the clock, not by the count
+            engine._settle(stop)
         return done
     stream = next((o for o in chain if isinstance(o, EventStream)), None)
     keeper = next((o for o in chain if isinstance(o, Checkpointer)), None)
     plan = RunPlan(
-        until,
+        None if stop == math.inf else stop,
         limit,
         unit,
         engine.time,
@@ -123,7 +157,32 @@ def drive(
         None if keeper is None else keeper.every,
         None if stream is None else str(stream.path.absolute()),
     )
-    return _drive_chunks(engine, plan, stop, chain, stream)
+    return _drive_chunks(engine, plan, chain, stream)
+
+
+def run_limits(until, limit, now: float, unit: str) -> tuple[float, int | None]:
+    """``(stop, limit)`` from ``run(until=..., events=...)``: the one internal spelling of the limits.
+
+    ``stop`` is a float, ``math.inf`` for no stop time (``until`` None, or ``inf`` with a count); ``limit``
+    an int >= 0, or None for no count.
+
+    Raises:
+        TimeError: ``until`` before ``now``, NaN or not a number, or infinite without a count.
+        InvalidArgumentError: a count that is not a whole number >= 0, or neither limit.
+
+    Example:
+        >>> run_limits(None, 5, 0.0, "events"), run_limits(2.0, None, 0.0, "events")
+        ((inf, 5), (2.0, None))
+    """
+    until = check_until(until, now)
+    limit = check_count(unit, limit)
+    if until is None and limit is None:
+        msg = f"run() needs until=... or {unit}=..."
+        raise InvalidArgumentError(msg)
+    if until == math.inf and limit is None:
+        msg = f"run(until=inf) never ends: give a finite until or {unit}=..."
+        raise TimeError(msg)
+    return (math.inf if until is None else until), limit
 
 
 #: The order in which observers are served: the stream takes each chunk before a checkpoint refers to it.
@@ -166,19 +225,20 @@ def _observers(observers, progress, record_to, checkpoint, every) -> list[Observ
     return chain
 
 
-def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], stream) -> int:
+def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
     """Run in chunks of the engine's loop, serving ``chain`` between them."""
     for observer in chain:  # every check before anything changes
         observer.check(engine, plan)
     wants_events = any(observer.wants_events for observer in chain)
     keep = engine.record and stream is None  # the log stays in memory (else the stream takes it)
-    log = engine._log
-    before = (engine._stream, engine._run_id)
+    context = engine.run_context
+    log = context.log
+    before = (context.stream, context.run_id)
     started: list[Observer] = []
     done = 0
     completed = False
     try:
-        engine._recording = wants_events  # the loop logs for the observers, whatever record says
+        context.recording = wants_events  # the loop logs for the observers, whatever record says
         try:
             for observer in chain:
                 observer.start(engine, plan)
@@ -187,7 +247,7 @@ def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], str
             for observer in reversed(started):  # nothing has run: leave no file and no trace behind
                 observer.finish(engine, False)
                 observer.undo_start()
-            engine._stream, engine._run_id = before
+            context.stream, context.run_id = before
             started = []
             raise
         if not keep:
@@ -199,10 +259,10 @@ def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], str
                 want = observer.next_stop(engine)
                 if want is not None:
                     chunk = max(1, want) if chunk is None else min(chunk, max(1, want))
-            k = engine._advance(stop, chunk)
+            k = engine._advance(plan.stop, chunk)
             done += k
             finishing = chunk is None or k < chunk or done == plan.limit  # None: the call did it all
-            if plan.until is not None and finishing and done != plan.limit:
+            if plan.until is not None and finishing and done != plan.limit:  # stopped by the clock
                 engine._settle(plan.until)
             events = log.since(mark) if wants_events else None
             if not keep:
@@ -218,7 +278,10 @@ def _drive_chunks(engine, plan: RunPlan, stop: float, chain: list[Observer], str
                 break
         completed = True
     finally:
-        engine._recording = False
+        context.recording = False
         for observer in reversed(started):
             observer.finish(engine, completed)
     return done
+
+
+provide("run", run_engine)

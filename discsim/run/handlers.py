@@ -35,7 +35,7 @@ class EventHandlers(Observer):
         """Take each disc's velocity, mass and radius now, and the map from ids to indices."""
         self._velocities = np.array(engine.velocities)  # each disc's velocity before the next chunk
         self._masses, self._radii = engine.discs.masses, engine.discs.radii
-        self._structure = engine._structure
+        self._structure = engine.run_context.structure
         ids = engine.ids
         self._index = np.full(int(ids.max()) + 1 if len(ids) else 0, -1, dtype=np.int64)  # id -> index, -1: gone
         self._index[ids] = np.arange(len(ids))
@@ -72,5 +72,5 @@ class EventHandlers(Observer):
         for k in range(len(found)):
             for fn in self.handlers.get(str(found.kind[k]), ()):
                 fn(engine, found[k])
-        if engine._structure != self._structure:  # a callback added or removed discs
+        if engine.run_context.structure != self._structure:  # a callback added or removed discs
             self._look(engine)

@@ -16,7 +16,6 @@ Example:
 
 from __future__ import annotations
 
-import uuid
 from pathlib import Path
 
 import numpy as np
@@ -138,7 +137,8 @@ class EventStream(Observer):
         self._time = None  # the engine's time after the last chunk handed over
 
     def check(self, engine, plan) -> None:
-        stream, logged = engine._stream, engine._event_count()
+        context = engine.run_context
+        stream, logged = context.stream, engine._event_count()
         if not self.path.parent.is_dir():
             msg = f"cannot write the event log record_to={str(self.path)!r}: no folder {self.path.parent}"
             raise FileNotFoundError(msg)
@@ -156,7 +156,7 @@ class EventStream(Observer):
                 "(choose another path or remove the file)"
             )
             raise CheckpointError(msg)
-        missed = logged - stream["base"] - stream["records"] - len(engine._log)
+        missed = logged - stream["base"] - stream["records"] - len(context.log)
         if missed:
             why = (
                 f"writing them failed: {stream['write_error']}"
@@ -174,7 +174,8 @@ class EventStream(Observer):
         ).close()
 
     def start(self, engine, plan) -> None:
-        stream, logged = engine._stream, engine._event_count()
+        context = engine.run_context
+        stream, logged = context.stream, engine._event_count()
         if stream is not None and self.path.exists():
             self._writer = RecordWriter.reopen(  # check() has just verified every chunk
                 self.path,
@@ -183,23 +184,22 @@ class EventStream(Observer):
                 expect={"run_id": stream["run_id"], "base": stream["base"]},
                 verify=False,
             )
-            engine._stream = {**stream, "path": str(self.path.absolute())}
-            self._hold(engine._log.since(0))  # recorded since the last flush
+            context.stream = {**stream, "path": str(self.path.absolute())}
+            self._hold(context.log.since(0))  # recorded since the last flush
             return
-        from_start = stream is None and len(engine._log) == logged  # the log in memory covers the whole run
+        from_start = stream is None and len(context.log) == logged  # the log in memory covers the whole run
         if from_start:
-            (discs, ids), start, base = engine._log_origin(), engine.start_time, 0
-            self._hold(engine._log.since(0))
+            (discs, ids), start, base = context.log_origin(engine.discs), engine.start_time, 0
+            self._hold(context.log.since(0))
         else:  # earlier events stay out of this file
-            discs, ids, start, base = engine.snapshot(), engine._ids, engine.time, logged
-        if engine._run_id is None:
-            engine._run_id = uuid.uuid4().hex
-        meta, arrays = stream_header(discs, engine.box, start, engine._run_id, base, ids)
+            discs, ids, start, base = engine.snapshot(), context.ids, engine.time, logged
+        run_id = context.ensure_run_id()
+        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids)
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
         self._created = True
-        engine._stream = {
+        context.stream = {
             "path": str(self.path.absolute()),
-            "run_id": engine._run_id,
+            "run_id": run_id,
             "base": base,
             "records": 0,
             "end": self._writer.end,
@@ -221,14 +221,15 @@ class EventStream(Observer):
 
     def flush(self, engine) -> None:
         """Write the events held as one chunk, stamped with the time it covers up to."""
+        context = engine.run_context
         records = np.concatenate(self._pending) if self._pending else np.zeros(0, dtype=EVENT_DTYPE)
         self._pending, self._held = [], 0
         try:
             self._writer.append(records, {"time": engine.time if self._time is None else self._time})
         except OSError as exc:  # a full disk, say: these events are lost to the log; say so if asked again
-            engine._stream = {**engine._stream, "write_error": f"{type(exc).__name__}: {exc}"}
+            context.stream = {**context.stream, "write_error": f"{type(exc).__name__}: {exc}"}
             raise
-        engine._stream = {**engine._stream, "records": self._writer.records, "end": self._writer.end}
+        context.stream = {**context.stream, "records": self._writer.records, "end": self._writer.end}
 
     def sync(self) -> None:
         """Force what was written to disk."""
@@ -270,7 +271,8 @@ class Checkpointer(Observer):
             raise FileNotFoundError(msg)
         if self.path.exists():
             meta, _ = read_state(self.path)
-            if engine._run_id is None or meta.get("run_id") != engine._run_id:
+            run_id = engine.run_context.run_id
+            if run_id is None or meta.get("run_id") != run_id:
                 msg = (
                     f"{self.path} holds a checkpoint of another run; discsim will not overwrite it "
                     "(choose another path, or resume that run with discsim.resume)"

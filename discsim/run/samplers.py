@@ -118,7 +118,7 @@ class Sampler(Observer):
                 "it moved outside run(..., observers=[sampler]) and the sampler missed those events"
             )
             raise InvalidArgumentError(msg)
-        if self._state is not None and engine._structure != self._structure:
+        if self._state is not None and engine.run_context.structure != self._structure:
             raise InvalidArgumentError(self._changed_message(engine.time))
 
     @staticmethod
@@ -129,7 +129,7 @@ class Sampler(Observer):
         )
 
     def start(self, engine, plan) -> None:
-        self._structure = engine._structure
+        self._structure = engine.run_context.structure
         if self._engine_id is None:
             self._engine_id = id(engine)
             self._origin = engine.time

@@ -236,7 +236,7 @@ def compress(
     start = _time.perf_counter()
     bar_context = None
     if progress:
-        from discsim.run.progress import progress_bar  # the top floor, called late
+        from discsim._progress import progress_bar
 
         bar_context = progress_bar(100.0, by_time=False, unit="%")
         bar = bar_context.__enter__()

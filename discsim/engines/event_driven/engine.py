@@ -14,7 +14,7 @@ import numpy as np
 
 from discsim._numba import resolve_backend
 from discsim.cells import CellGrid, neighbour_pairs
-from discsim.engines.base import Engine
+from discsim.engines.base import Engine, register_engine
 from discsim.engines.event_driven.numba import NumbaBackend
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.protocol import Backend
@@ -32,6 +32,7 @@ INF = math.inf
 BACKENDS: dict[str, type[Backend]] = {"python": PythonBackend, "numba": NumbaBackend}
 
 
+@register_engine
 class EventDriven(Engine):
     """Exact event-driven simulation of elastic hard discs (PIC).
 

@@ -36,12 +36,13 @@ from discsim._interrupt import deferred_interrupt
 from discsim._numba import resolve_backend
 from discsim._validate import check_count, positive_finite
 from discsim.cells import CellGrid
-from discsim.engines.base import Engine
+from discsim.engines.base import Engine, register_engine
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BROAD_PHASE_CLASSES
 from discsim.engines.fixed_step.frame import FRAME_POLICY_CLASSES
 from discsim.engines.fixed_step.state import FixedStepState
 from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisect
+from discsim.engines.record import collision_virials
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
 from discsim.model import Box, Discs, _readonly
@@ -67,6 +68,7 @@ DEFAULT_FRAME_RATE = 30.0
 DEFAULT_BISECT_FRACTION = 1e-6
 
 
+@register_engine
 class FixedStep(Engine):
     """Fixed-step simulation with a periodic interference test (PIT).
 
@@ -328,8 +330,6 @@ class FixedStep(Engine):
         sim._edits = int(settings.get("edits", 0))
         if math.isnan(state.virial) and len(events) == state.detections + state.wall_hits + sim._edits:
             # A version 1 state (no virial) whose log holds the whole run: the virial is in the log.
-            from discsim.analysis.thermo import collision_virials
-
             state.virial = float(np.sum(collision_virials(events, scene.discs.masses, scene.box)[1]))
         sim._load(state)
         if len(events):
@@ -363,8 +363,8 @@ class FixedStep(Engine):
     def _advance(self, until: float, limit: int | None) -> int:
         todo = self._frames_due(until)
         if limit is not None:
-            todo = min(todo, limit)
-        if todo == math.inf:
+            todo = limit if todo is None else min(todo, limit)
+        if todo is None:
             msg = "a fixed-step run needs a finite until or a frame count"
             raise InvalidArgumentError(msg)
         done = 0
@@ -383,13 +383,14 @@ class FixedStep(Engine):
                     done += count
         return todo
 
-    def _frames_due(self, until: float) -> float:
-        """Frames still to do up to time ``until`` (inf for ``until=inf``), allowing for the roundoff of ``k * dt``.
+    def _frames_due(self, until: float) -> int | None:
+        """Frames still to do up to time ``until``, allowing for the roundoff of ``k * dt``; None (no count) for
+        ``until = inf``.
 
         Counted from the start, so that a run gives the same frames however it is cut into calls.
         """
         if until == math.inf:
-            return math.inf
+            return None
         last = math.floor((until - self.start_time) / self.dt * (1 + 1e-12) + 1e-9)
         return max(0, last - self.frames)
 

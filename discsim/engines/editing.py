@@ -1,0 +1,383 @@
+"""Changing a simulation between events: :class:`DiscEditing`, the part of every engine behind
+``set_velocities``, ``apply_impulse``, ``set_positions``, ``add_discs``, ``remove_discs``, ``ids`` and ``on``.
+
+Each change is checked whole before anything changes (the errors name the disc and the value), then made by
+the engine's own ``_set_discs(indices, positions, velocities)`` or ``_restructure(keep, added, scene)``
+(:class:`~discsim.engines.base.Engine`'s abstract methods), logged (``SET``, ``ADD``, ``REMOVE`` records)
+and counted. A mixin of :class:`~discsim.engines.base.Engine`: it reads the engine's ``discs``, ``box``,
+``scene``, ``time``, ``positions``, ``velocities`` and log, and holds nothing of its own.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+
+from discsim.engines.context import RunContext, readonly_ids
+from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
+from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs
+from discsim.scene import Scene, check_added
+
+__all__ = ["DiscEditing"]
+
+
+class DiscEditing:
+    """The disc-editing methods every engine shares (see the module docstring)."""
+
+    # What the engine gives these methods (declared for type checkers; Engine sets or defines each).
+    scene: Scene
+    discs: Discs
+    box: Box
+    segments: tuple
+    time: float
+    run_context: RunContext
+    _edits: int
+    _logging: bool
+
+    if TYPE_CHECKING:
+
+        @property
+        def positions(self) -> np.ndarray: ...
+        @property
+        def velocities(self) -> np.ndarray: ...
+        def snapshot(self) -> Discs: ...
+        def _check_usable(self) -> None: ...
+        def _log_origin(self) -> tuple[Discs, np.ndarray | None]: ...
+        def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None: ...
+        def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None: ...
+
+    #: Event kinds a callback can follow with :meth:`on`.
+    CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment")
+
+    def set_velocities(self, indices, velocities):
+        """Give discs ``indices`` new ``velocities`` ``(K, 2)`` (or one ``(2,)`` for all) at ``time``.
+
+        Each change is an event of its own in the log (kind ``"set"``), so :meth:`trajectory` stays exact;
+        only the discs changed are re-predicted. Returns ``self``.
+
+        Raises:
+            InvalidArgumentError: an index that is not a disc, a repeated index, a wrong shape, a NaN or
+                infinite velocity, or an obstacle (infinite mass; obstacles stay where they are).
+            UnitsError: a speed outside the supported range. Nothing changes then.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[0.0, 0.0], [0.0, 0.0]], 1.0), ds.Box(10, 10))
+            >>> sim.set_velocities([0], [[1.0, 0.0]]).run(until=4.5).velocities.tolist()
+            [[0.0, 0.0], [1.0, 0.0]]
+        """
+        idx = self._disc_indices(indices)
+        self._change(idx, None, self._rows("velocities", velocities, idx))
+        return self
+
+    def apply_impulse(self, indices, impulses):
+        """Push discs ``indices`` with ``impulses`` ``(K, 2)`` (momentum, or one ``(2,)`` for all): ``dv = J / m``.
+
+        Returns ``self``. Raises as :meth:`set_velocities` (obstacles refuse to be pushed).
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], 1.0, masses=2.0), ds.Box(10, 10))
+            >>> sim.apply_impulse([0], [0.0, 4.0]).velocities.tolist()
+            [[1.0, 2.0]]
+        """
+        idx = self._disc_indices(indices)
+        impulses = self._rows("impulses", impulses, idx)
+        self._refuse_obstacles(idx)
+        velocities = self.velocities[idx] + impulses / self.discs.masses[idx][:, None]
+        self._change(idx, None, velocities)
+        return self
+
+    def set_positions(self, indices, positions):
+        """Move discs ``indices`` to ``positions`` ``(K, 2)`` at ``time``, keeping their velocities.
+
+        Validated as the constructor validates: each disc must lie in the box (in ``[0, width) x
+        [0, height)`` when periodic), clear of the walls, the segments and every other disc (pairs that
+        pass through each other excepted). Returns ``self``.
+
+        Raises:
+            OutsideBoxError, OverlapError: naming the disc (and the disc it would overlap).
+            InvalidArgumentError: as :meth:`set_velocities`. Nothing changes then.
+        """
+        idx = self._disc_indices(indices)
+        self._change(idx, self._rows("positions", positions, idx), None)
+        return self
+
+    def add_discs(self, discs: Discs) -> np.ndarray:
+        """Add ``discs`` (a :class:`~discsim.model.Discs` of ``K`` discs: positions in the box, velocities, radii,
+        masses, groups) at ``time``. Returns their indices ``N, ..., N + K - 1`` ``(K,)`` int64.
+
+        Validated as the constructor validates the discs: each new disc must lie in the box (in ``[0, width)
+        x [0, height)`` when periodic), clear of the walls, the segments, every disc already there and every
+        other new one (pairs whose groups pass through each other excepted); NaN, non-positive radii or
+        negative masses are refused by ``Discs`` itself. Each new disc gets the next disc id (:attr:`ids`)
+        and an ``ADD`` record in the log (:meth:`~discsim.events.EventLog.add`), so :meth:`trajectory` and
+        the log's readers know where it came from.
+
+        The run goes on from a fresh start at ``time``: every disc is re-predicted (O(N), the cost of
+        building the engine), so ``EventDriven`` then gives, event for event and bit for bit, what a new
+        ``EventDriven(sim.snapshot(), box)`` would give from the same discs (its times shifted by ``time``).
+        Add many discs in one call rather than one by one.
+
+        Raises:
+            WrongTypeError: ``discs`` is not a ``Discs``.
+            OutsideBoxError: a new disc is outside the box or cut by a wall or segment, named by the index it
+                would get. Nothing changes then, for this error and every one below.
+            OverlapError: a new disc would overlap a disc (named, with the other disc and the depth).
+            UnitsError: a radius or speed outside what discsim resolves.
+            BoxTooSmallError: the larger discs no longer fit a periodic box's cell grid (3 cells of the
+                largest diameter a side).
+            InvalidArgumentError: the larger discs no longer fit the engine's ``cell_size``.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.EventDriven(ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], 1.0), ds.Box(10, 10)).run(until=1.0)
+            >>> sim.add_discs(ds.Discs([[8.0, 5.0]], [[-1.0, 0.0]], 1.0)).tolist()
+            [1]
+            >>> sim.run(until=3.0).counts["collisions"], sim.velocities.tolist()
+            (1, [[-1.0, 0.0], [1.0, 0.0]])
+        """
+        self._check_usable()
+        if not isinstance(discs, Discs):
+            msg = f"add_discs needs a discsim.Discs, got {type(discs).__name__} {str(discs)[:60]}"
+            raise WrongTypeError(msg)
+        n, k = len(self.discs), len(discs)
+        if k == 0:
+            return np.zeros(0, dtype=np.int64)
+        speed = np.hypot(discs.velocities[:, 0], discs.velocities[:, 1])
+        lo, hi = SPEED_RANGE
+        bad = (speed > hi) | ((speed < lo) & (speed != 0.0))
+        if bad.any():
+            b = int(np.flatnonzero(bad)[0])
+            msg = (
+                f"new disc {n + b} would have speed {float(speed[b])!r}, outside the range discsim supports "
+                f"([{lo:g}, {hi:g}] or 0; discsim.model.SPEED_RANGE)"
+            )
+            raise UnitsError(msg)
+        now = self.snapshot()
+        everyone = Discs(
+            np.concatenate([now.positions, discs.positions]),
+            np.concatenate([now.velocities, discs.velocities]),
+            np.concatenate([now.radii, discs.radii]),
+            np.concatenate([now.masses, discs.masses]),
+            np.concatenate([now.groups, discs.groups]),
+        )
+        scene = self.scene
+        check_added(everyone, self.box, n, scene.segments, scene.pass_through)
+        new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, check=False)
+        context = self.run_context
+        ids = np.arange(context.next_id, context.next_id + k, dtype=np.int64)
+        ids_after, origin = np.concatenate([self.ids, ids]), self._log_origin()
+        self._restructure(np.arange(n), discs, new_scene)
+        self._new_discs(new_scene, ids_after, context.next_id + k, origin)
+        if self._logging or context.streamed:
+            context.log.add(self.time, ids, discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups)
+        self._edits += k
+        return np.arange(n, n + k, dtype=np.int64)
+
+    def remove_discs(self, indices):
+        """Remove discs ``indices`` (a list of distinct indices, or one) at ``time``. Returns ``self``.
+
+        The discs after them move down to fill the gaps, as ``np.delete`` does: with ``N`` discs,
+        removing disc ``i`` makes disc ``k > i`` disc ``k - 1``. Indices always number the discs there
+        now (``positions``, ``velocities``, ``discs``, ``step()``'s events, callbacks' contacts), while the
+        log names every disc by its id, which never changes (:attr:`ids` gives the id of each disc now).
+        Each removed disc gets a ``REMOVE`` record (:meth:`~discsim.events.EventLog.remove`); its column of
+        :meth:`trajectory` is NaN from then on. The run goes on from a fresh start at ``time``, as after
+        :meth:`add_discs`.
+
+        Raises:
+            InvalidArgumentError: an index that is not a disc, a repeated index, or one that is not an
+                integer. Nothing changes then.
+
+        Example:
+            >>> import discsim as ds
+            >>> discs = ds.Discs([[2.0, 5.0], [5.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [0.0, 0.0], [-1.0, 0.0]], 0.5)
+            >>> sim = ds.EventDriven(discs, ds.Box(10, 10)).remove_discs([1])
+            >>> sim.ids.tolist(), sim.run(until=2.9).counts["collisions"], sim.velocities.tolist()
+            ([0, 2], 1, [[-1.0, 0.0], [1.0, 0.0]])
+        """
+        idx = self._disc_indices(indices)
+        self._check_usable()
+        if not len(idx):
+            return self
+        n = len(self.discs)
+        keep = np.delete(np.arange(n), idx)
+        now = self.snapshot()
+        gone_positions, gone_velocities = now.positions[np.sort(idx)], now.velocities[np.sort(idx)]
+        rest = Discs(now.positions[keep], now.velocities[keep], now.radii[keep], now.masses[keep], now.groups[keep])
+        scene = self.scene
+        new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
+        gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()
+        self._restructure(keep, None, new_scene)
+        self._new_discs(new_scene, ids_after, self.run_context.next_id, origin)
+        if self._logging or self.run_context.streamed:
+            self.run_context.log.remove(self.time, gone, gone_positions, gone_velocities)
+        self._edits += len(idx)
+        return self
+
+    def _new_discs(self, scene: Scene, ids: np.ndarray, next_id: int, origin: tuple) -> None:
+        """After :meth:`_restructure`: the new scene and ids (the log's rows so far renamed by the old ones), and
+        ``origin``, the discs where the log starts (:meth:`_log_origin` before the change)."""
+        context = self.run_context
+        context.log.flush()
+        self.scene, self.discs = scene, scene.discs
+        context.set_ids(ids, next_id, origin)
+        context.structure += 1
+
+    @property
+    def ids(self) -> np.ndarray:
+        """``(N,)`` int64, read-only: the id of each disc, the name the event log and :meth:`trajectory` give it.
+
+        A disc's id is its index until some disc is removed (:meth:`remove_discs`): indices then shift down
+        while ids never change; a disc added later gets the next id never used.
+        """
+        ids = self.run_context.ids
+        return readonly_ids(np.arange(len(self.discs), dtype=np.int64)) if ids is None else ids
+
+    @property
+    def _origin(self) -> tuple[Discs, np.ndarray | None] | None:
+        """``run_context.origin`` (read-only here)."""
+        return self.run_context.origin
+
+    @property
+    def _next_id(self) -> int:
+        """``run_context.next_id`` (read-only here)."""
+        return self.run_context.next_id
+
+    def on(self, kind: str, fn):
+        """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"`` or ``"segment"``).
+
+        ``contact`` is a :class:`~discsim.analysis.contacts.Contact` (time, kind, discs, contact point,
+        unit normal, impulse, normal speed). The callback may change the simulation (``set_velocities``,
+        ``apply_impulse``, ``set_positions``) and the run goes on exactly from there. While a callback is
+        registered, ``run()`` advances one physical event (or frame) at a time, so each callback sees the
+        state just after its event: see the README for the cost. Returns ``self``.
+
+        Raises:
+            InvalidArgumentError: an unknown kind (naming it) or a ``fn`` that is not callable.
+        """
+        if not isinstance(kind, str) or kind not in self.CALLBACK_KINDS:
+            msg = f"on() follows one of {list(self.CALLBACK_KINDS)}, got {kind!r}"
+            raise InvalidArgumentError(msg)
+        if not callable(fn):
+            msg = f"on({kind!r}, fn) needs a callable fn(sim, contact), got {type(fn).__name__}"
+            raise InvalidArgumentError(msg)
+        self.run_context.handlers.setdefault(kind, []).append(fn)
+        return self
+
+    def _disc_indices(self, indices) -> np.ndarray:
+        """``indices`` as a ``(K,)`` int array of distinct existing discs."""
+        n = len(self.discs)
+        try:
+            idx = np.atleast_1d(np.asarray(indices))
+        except (TypeError, ValueError) as exc:
+            msg = f"indices must be integers in [0, {n}), got {indices!r}"
+            raise InvalidArgumentError(msg) from exc
+        if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
+            msg = f"indices must be a list of integers in [0, {n}), got {indices!r}"
+            raise InvalidArgumentError(msg)
+        idx = idx.astype(np.int64)
+        bad = (idx < 0) | (idx >= n)
+        if bad.any():
+            msg = f"disc index {int(idx[bad][0])} does not exist (this simulation has discs 0 to {n - 1})"
+            raise InvalidArgumentError(msg)
+        unique, counts = np.unique(idx, return_counts=True)
+        if (counts > 1).any():
+            msg = f"disc index {int(unique[counts > 1][0])} is given twice"
+            raise InvalidArgumentError(msg)
+        return idx
+
+    @staticmethod
+    def _rows(name: str, values, idx: np.ndarray) -> np.ndarray:
+        """``values`` as a finite ``(K, 2)`` float array (one ``(2,)`` row is repeated for every disc)."""
+        try:
+            rows = np.array(values, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            msg = f"{name} must be numbers of shape ({len(idx)}, 2), got {values!r}"
+            raise InvalidArgumentError(msg) from exc
+        if rows.shape == (2,):
+            rows = np.tile(rows, (len(idx), 1))
+        if rows.shape != (len(idx), 2):
+            msg = f"{name} must have shape ({len(idx)}, 2) for {len(idx)} discs, got shape {rows.shape}"
+            raise InvalidArgumentError(msg)
+        bad = ~np.isfinite(rows).all(axis=1)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            msg = f"disc {int(idx[k])} would get non-finite {name} {rows[k].tolist()}"
+            raise InvalidArgumentError(msg)
+        return rows
+
+    def _refuse_obstacles(self, idx: np.ndarray) -> None:
+        fixed = np.isinf(self.discs.masses[idx])
+        if fixed.any():
+            msg = f"disc {int(idx[fixed][0])} is an obstacle (infinite mass): it cannot be moved or pushed"
+            raise InvalidArgumentError(msg)
+
+    def _change(self, idx: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray | None) -> None:
+        """Check every change first, then make them all, log them, and count them."""
+        self._check_usable()
+        self._refuse_obstacles(idx)
+        if velocities is None:
+            velocities = self.velocities[idx]
+        speed = np.hypot(velocities[:, 0], velocities[:, 1])
+        lo, hi = SPEED_RANGE
+        bad = (speed > hi) | ((speed < lo) & (speed != 0.0))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            msg = (
+                f"disc {int(idx[k])} would get speed {float(speed[k])!r}, outside the range discsim supports "
+                f"([{lo:g}, {hi:g}] or 0; discsim.model.SPEED_RANGE)"
+            )
+            raise UnitsError(msg)
+        if positions is not None:
+            self._check_places(idx, positions)
+        if len(idx):
+            self._set_discs(idx, positions, velocities)
+        self._edits += len(idx)
+        if (self._logging or self.run_context.streamed) and len(idx):  # a streamed log takes it at the next run
+            t, pos, vel, ids = self.time, self.positions[idx], self.velocities[idx], self.ids[idx]
+            for k, i in enumerate(ids.tolist()):
+                self.run_context.log.set(t, i, pos[k, 0], pos[k, 1], vel[k, 0], vel[k, 1])
+
+    def _check_places(self, idx: np.ndarray, positions: np.ndarray) -> None:
+        """Refuse positions outside the box, cut by a wall or a segment, or overlapping another disc."""
+        box, radii = self.box, self.discs.radii
+        size = box.size
+        for k, i in enumerate(idx.tolist()):
+            p, r = positions[k], radii[i]
+            if box.periodic:
+                outside, what = bool(((p < 0) | (p >= size)).any()), "outside the periodic box [0, width) x [0, height)"
+            else:
+                slack = OVERLAP_TOLERANCE * r
+                outside, what = (
+                    bool(((p - r < -slack) | (p + r > size + slack)).any()),
+                    "outside the box or cut by a wall",
+                )
+            if outside:
+                msg = f"disc {i} at {p.tolist()} with radius {r:g} would be {what} (box {box.width:g} x {box.height:g})"
+                raise OutsideBoxError(msg)
+            for s, segment in enumerate(self.segments):
+                if float(segment.distance(p[None, :])[0]) < r * (1.0 - OVERLAP_TOLERANCE):
+                    msg = f"disc {i} at {p.tolist()} with radius {r:g} would be cut by segment {s} {segment!r}"
+                    raise OutsideBoxError(msg)
+        places = np.array(self.positions)  # a writable copy
+        places[idx] = positions
+        everyone = np.arange(len(radii))
+        for k, i in enumerate(idx.tolist()):
+            d = box.minimum_image(places - places[i])
+            dist = np.hypot(d[:, 0], d[:, 1])
+            contact = radii + radii[i]
+            depth = contact - dist
+            bad = depth > OVERLAP_TOLERANCE * contact
+            bad[i] = False
+            if self.scene.filtering:
+                bad &= ~self.scene.passes(np.full(len(radii), i), everyone)
+            if bad.any():
+                j = int(np.flatnonzero(bad)[np.argmax((depth / contact)[bad])])
+                msg = (
+                    f"disc {i} at {positions[k].tolist()} would overlap disc {j} by {depth[j]:.6g} "
+                    f"(distance {dist[j]:.6g}, contact distance {contact[j]:.6g})"
+                )
+                raise OverlapError(msg)

@@ -8,6 +8,7 @@ the commit before a refactor. Run::
     python benchmarks/ab_throughput.py --base PATH --sizes 1000 10000 --packings 0.3 --repeats 3 --collisions 200000
     python benchmarks/ab_throughput.py --base PATH --quick --out DIR     # seconds: proves the script runs
     python benchmarks/ab_throughput.py --base PATH --backend numba       # the compiled loop instead
+    python benchmarks/ab_throughput.py --base PATH --compile             # numba's first compile and warm start
 
 The defaults (N = 10^3, 10^4, 10^5; packing fractions 0.3 and 0.7; 5 repeats of
 300,000 collisions) take about a quarter of an hour.
@@ -92,6 +93,72 @@ done = sim.counts["collisions"] - before
 print(json.dumps({"discsim_file": str(where), "collisions": done, "seconds": seconds,
                   "collisions_per_s": done / seconds}))
 """
+
+
+#: Run by :func:`start_seconds` in a fresh interpreter: seconds to import discsim, build a compiled engine of 100
+#: discs and process its first event (the compile, or the load of the machine code from numba's cache).
+_START_PROBE = """
+import sys, time
+start = time.perf_counter()
+import discsim
+sim = discsim.EventDriven(*discsim.random_gas(100, 0.3, seed=1), backend="numba")
+sim.step()
+print(time.perf_counter() - start)
+"""
+
+
+def start_seconds(tree: Path, cache: Path, scratch: Path) -> float:
+    """Seconds of one :data:`_START_PROBE` run of ``tree`` with numba's cache in ``cache`` (empty: a cold start)."""
+    env = dict(
+        os.environ, PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(scratch / "pycache"), NUMBA_CACHE_DIR=str(cache)
+    )
+    env.pop("DISCSIM_NO_NUMBA", None)
+    done = subprocess.run([sys.executable, "-c", _START_PROBE], cwd=scratch, env=env, capture_output=True, text=True)
+    if done.returncode:
+        msg = f"the start of {tree} failed:\n{done.stderr}"
+        raise RuntimeError(msg)
+    return float(done.stdout.split()[-1])
+
+
+def compile_pairs(base: Path, repeats: int, scratch: Path) -> list[dict]:
+    """Cold and warm starts of both trees, alternating; one row per kind of start (medians and pair ratios)."""
+    trees = {"base": base, "new": NEW_TREE}
+    seconds: dict[tuple[str, str], list[float]] = {(kind, side): [] for kind in ("cold", "warm") for side in SIDES}
+    for repeat in range(repeats):
+        for side in SIDES if repeat % 2 == 0 else SIDES[::-1]:
+            cache = Path(tempfile.mkdtemp(dir=scratch))
+            seconds["cold", side].append(start_seconds(trees[side], cache, scratch))
+            seconds["warm", side].append(start_seconds(trees[side], cache, scratch))
+            announce(
+                f"  repeat {repeat + 1}/{repeats} {side}: cold {seconds['cold', side][-1]:.2f} s, "
+                f"warm {seconds['warm', side][-1]:.2f} s"
+            )
+    rows = []
+    for kind in ("cold", "warm"):
+        ratios = [n / b for n, b in zip(seconds[kind, "new"], seconds[kind, "base"])]
+        rows.append(
+            {
+                "start": kind,
+                "repeats": repeats,
+                "base_seconds": median(seconds[kind, "base"]),
+                "new_seconds": median(seconds[kind, "new"]),
+                "ratio_median": median(ratios),
+                "ratio_min": min(ratios),
+                "ratio_max": max(ratios),
+            }
+        )
+    return rows
+
+
+COMPILE_COLUMNS = [
+    Column("start", "start"),
+    Column("repeats", "repeats"),
+    Column("base_seconds", "base s", ".2f"),
+    Column("new_seconds", "new s", ".2f"),
+    Column("ratio_median", "new/base", ".3f"),
+    Column("ratio_min", "min", ".3f"),
+    Column("ratio_max", "max", ".3f"),
+]
 
 
 def warmup_collisions(n: int) -> int:
@@ -259,6 +326,9 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument(
         "--backend", choices=("python", "numba"), default="python", help="the event loop compared (default python)"
     )
+    parser.add_argument(
+        "--compile", action="store_true", help="time numba's cold and warm starts instead (--repeats pairs)"
+    )
     args = parser.parse_args(argv)
     defaults = QUICK if args.quick else FULL
     for key, value in defaults.items():
@@ -279,6 +349,8 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run every pair, print the table, write ``ab_throughput.csv`` and ``ab_throughput.png``; return the exit code."""
     args = parse_args(argv)
+    if args.compile:
+        return compile_main(args)
     options = {key: getattr(args, key) for key in (*FULL, "backend")}
     labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE), "backend": args.backend}
     print(f"discsim A/B throughput; {machine_summary()}")
@@ -299,6 +371,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     title = f"discsim EventDriven ({args.backend}): {labels['new_label']} / {labels['base_label']}"
     png = plot(rows, args.out / f"{stem}.png", title)
     print(f"wrote {csv_path}, {png}")
+    return 0
+
+
+def compile_main(args: argparse.Namespace) -> int:
+    """``--compile``: the cold and warm starts table, ``ab_compile.csv``."""
+    labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE)}
+    print(f"discsim A/B start of the compiled backend; {machine_summary()}")
+    print(f"base: {args.base} ({labels['base_label']}); new: {NEW_TREE} ({labels['new_label']})")
+    print("import + build 100 discs + first event, fresh processes; cold: an empty numba cache, warm: the same again")
+    with tempfile.TemporaryDirectory(prefix="ab_compile_") as scratch:
+        rows = compile_pairs(args.base, args.repeats, Path(scratch))
+    for row in rows:
+        row.update(labels)
+    print(format_table(rows, COMPILE_COLUMNS))
+    path = write_csv(args.out / "ab_compile.csv", rows, [c.key for c in COMPILE_COLUMNS] + list(labels))
+    print(f"wrote {path}")
     return 0
 
 

@@ -11,6 +11,8 @@ import sys
 import pytest
 from paths import ROOT
 
+from discsim._numba import available as numba_available
+
 REPO = ROOT
 BENCHMARKS = REPO / "benchmarks"
 
@@ -60,3 +62,23 @@ def test_instruction_counts_run_and_write_their_table(tmp_path):
     # The same tree on both sides; a tiny run's ratio still moves by a few percent (garbage collections,
     # address-dependent hashing), which the full run's 40,000 counted collisions average out.
     assert 0.5 < float(rows[0]["ratio"]) < 2.0
+
+
+@pytest.mark.slow  # two first compiles of the event loop
+@pytest.mark.skipif(not numba_available(), reason="the compiled backend needs numba")
+def test_compile_mode_times_cold_and_warm_starts(ab_throughput, tmp_path):
+    assert ab_throughput.main(["--compile", "--repeats", "1", "--base", str(REPO), "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "ab_compile.csv", newline="") as handle:
+        rows = {row["start"]: row for row in csv.DictReader(handle)}
+    assert set(rows) == {"cold", "warm"}
+    for side in ("base", "new"):  # a cold start compiles: it takes longer than a warm one, which loads
+        assert float(rows["cold"][f"{side}_seconds"]) > float(rows["warm"][f"{side}_seconds"]) > 0
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not numba_available(), reason="the compiled backend needs numba")
+def test_quick_run_of_the_compiled_loop(ab_throughput, tmp_path):
+    assert ab_throughput.main(["--quick", "--backend", "numba", "--base", str(REPO), "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "ab_throughput_numba.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 1 and rows[0]["backend"] == "numba" and float(rows[0]["new_median"]) > 0

@@ -9,7 +9,6 @@ instructions per collision. Run::
 
     python benchmarks/ab_instructions.py --base PATH_TO_OTHER_CHECKOUT [--sizes 1000 10000] [--packings 0.3 0.7]
     python benchmarks/ab_instructions.py --base PATH --quick --out DIR
-    python benchmarks/ab_instructions.py --base PATH --backend numba   # the compiled loop's machine code
 
 It needs valgrind (Debian's package); under it Python runs about 50 times slower, so the defaults (N = 10^3
 and 10^4, packing 0.3 and 0.7, K1 = 20,000 and K2 = 60,000) take about 40 minutes. Instructions are not
@@ -44,24 +43,22 @@ COLUMNS = [
 ]
 
 
-def instructions(tree: Path, n: int, packing: float, collisions: int, scratch: Path, backend: str = "python") -> int:
-    """Total instructions (callgrind's ``I refs``) of one probe run of ``tree`` with ``collisions`` timed.
-
-    With ``backend="numba"`` a run outside valgrind first fills the tree's numba cache, so that the counted
-    runs load the machine code instead of compiling it (the compile would dwarf the loop).
-    """
+def instructions(tree: Path, n: int, packing: float, collisions: int, scratch: Path) -> int:
+    """Total instructions (callgrind's ``I refs``) of one probe run of ``tree`` with ``collisions`` timed."""
     workdir = scratch / "cwd"
     workdir.mkdir(parents=True, exist_ok=True)
-    # DISCSIM_NO_NUMBA: with backend "python", trees with a compiled backend run their pure-Python loop.
-    env = dict(os.environ, PYTHONPATH=str(tree), PYTHONPYCACHEPREFIX=str(scratch / "pycache"), PYTHONHASHSEED="0")
-    env.pop("DISCSIM_NO_NUMBA", None)
-    if backend == "python":
-        env["DISCSIM_NO_NUMBA"] = "1"
-    args = [str(tree), str(n), repr(packing), "1", str(warmup_collisions(n)), str(collisions), backend]
-    # Compile the bytecode (and the compiled loop) first, outside the count, so that no counted run pays for it.
-    warm = [str(tree), "100", repr(packing), "1", "10", "10", backend] if backend == "numba" else None
-    prepare = [sys.executable, "-c", _PROBE, *warm] if warm else [sys.executable, "-c", "import discsim"]
-    subprocess.run(prepare, cwd=workdir, env=env, check=True, capture_output=True)
+    # DISCSIM_NO_NUMBA: trees with a compiled backend run their pure-Python loop, which is what is compared
+    # (older trees ignore the variable).
+    env = dict(
+        os.environ,
+        PYTHONPATH=str(tree),
+        PYTHONPYCACHEPREFIX=str(scratch / "pycache"),
+        PYTHONHASHSEED="0",
+        DISCSIM_NO_NUMBA="1",
+    )
+    args = [str(tree), str(n), repr(packing), "1", str(warmup_collisions(n)), str(collisions), "python"]
+    # Compile the bytecode first, outside the count, so that no counted run pays for it.
+    subprocess.run([sys.executable, "-c", "import discsim"], cwd=workdir, env=env, check=True)
     command = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", sys.executable, "-c", _PROBE]
     done = subprocess.run([*command, *args], cwd=workdir, env=env, capture_output=True, text=True, check=False)
     found = re.search(r"I\s+refs:\s+([\d,]+)", done.stderr)
@@ -78,9 +75,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--packings", type=float, nargs="+")
     parser.add_argument("--quick", action="store_true", help="a tiny run that proves the script works")
     parser.add_argument("--out", type=Path, help="CSV and PNG folder (default results/; --quick: a temporary one)")
-    parser.add_argument(
-        "--backend", choices=("python", "numba"), default="python", help="the event loop compared (default python)"
-    )
     args = parser.parse_args(argv)
     if shutil.which("valgrind") is None:
         print("valgrind is not installed (apt-get install valgrind); nothing measured", file=sys.stderr)
@@ -99,18 +93,16 @@ def main(argv: Sequence[str] | None = None) -> int:
                 row = {"n": n, "packing": packing}
                 for side in SIDES:
                     counts = [
-                        instructions(trees[side], n, packing, plan[k], Path(scratch) / side, args.backend)
-                        for k in ("short", "long")
+                        instructions(trees[side], n, packing, plan[k], Path(scratch) / side) for k in ("short", "long")
                     ]
                     row[f"{side}_per_collision"] = (counts[1] - counts[0]) / (plan["long"] - plan["short"])
                 row["ratio"] = row["new_per_collision"] / row["base_per_collision"]
-                row.update(base_label=labels["base"], new_label=labels["new"], backend=args.backend)
+                row.update(base_label=labels["base"], new_label=labels["new"])
                 announce(f"  N={n:,} phi={packing}: new/base {row['ratio']:.4f}")
                 rows.append(row)
     print(format_table(rows, COLUMNS))
     out = results_folder(args.out, args.quick)
-    stem = "ab_instructions" if args.backend == "python" else f"ab_instructions_{args.backend}"
-    write_csv(out / f"{stem}.csv", rows, [*(c.key for c in COLUMNS), "base_label", "new_label", "backend"])
+    write_csv(out / "ab_instructions.csv", rows, [*(c.key for c in COLUMNS), "base_label", "new_label"])
     return 0
 
 

@@ -9,6 +9,7 @@ the commit before a refactor. Run::
     python benchmarks/ab_throughput.py --base PATH --quick --out DIR     # seconds: proves the script runs
     python benchmarks/ab_throughput.py --base PATH --backend numba       # the compiled loop instead
     python benchmarks/ab_throughput.py --base PATH --compile             # numba's first compile and warm start
+    python benchmarks/ab_throughput.py --base PATH --engine fixed-step   # FixedStep frames/s (policy resolve)
 
 The defaults (N = 10^3, 10^4, 10^5; packing fractions 0.3 and 0.7; 5 repeats of
 300,000 collisions) take about a quarter of an hour.
@@ -95,6 +96,20 @@ print(json.dumps({"discsim_file": str(where), "collisions": done, "seconds": sec
 """
 
 
+#: ``--engine fixed-step``: the same, for FixedStep frames (policy ``resolve``, the ``grid`` broad phase, no
+#: log, ``dt = FRAME_DT``); "collisions" are frames here, and ``collisions_per_s`` frames per second.
+_FRAME_PROBE = (
+    _PROBE.replace(
+        "sim = discsim.EventDriven(discs, box, record=False, backend=backend)",
+        "sim = discsim.FixedStep(discs, box, dt=float(sys.argv[8]), record=False, backend=backend)",
+    )
+    .replace("sim.run(events=", "sim.run(frames=")
+    .replace('sim.counts["collisions"]', "sim.counts['frames']")
+)
+#: Time step of the fixed-step probe: about 1% of a diameter per frame at kT = 1 (unit masses and radii).
+FRAME_DT = 0.01
+
+
 #: Run by :func:`start_seconds` in a fresh interpreter: seconds to import discsim, build a compiled engine of 100
 #: discs and process its first event (the compile, or the load of the machine code from numba's cache).
 _START_PROBE = """
@@ -167,7 +182,14 @@ def warmup_collisions(n: int) -> int:
 
 
 def measure(
-    tree: Path, n: int, packing: float, seed: int, collisions: int, scratch: Path, backend: str = "python"
+    tree: Path,
+    n: int,
+    packing: float,
+    seed: int,
+    collisions: int,
+    scratch: Path,
+    backend: str = "python",
+    engine: str = "event-driven",
 ) -> dict:
     """One timed run of the tree ``tree`` in a fresh Python process.
 
@@ -179,6 +201,7 @@ def measure(
         scratch: a temporary folder; the run's working folder and bytecode cache go under it.
         backend: ``"python"`` (numba hidden) or ``"numba"`` (the compiled loop, from the tree's own cache of
             machine code: the warm-up pays any compile, outside the timed segment).
+        engine: ``"event-driven"`` (collisions) or ``"fixed-step"`` (frames: ``collisions`` is a frame count).
 
     Returns:
         The probe's dict: ``discsim_file``, ``collisions`` (timed), ``seconds``, ``collisions_per_s``.
@@ -193,9 +216,11 @@ def measure(
     env.pop("DISCSIM_NO_NUMBA", None)
     if backend == "python":
         env["DISCSIM_NO_NUMBA"] = "1"
-    args = [str(tree), str(n), repr(packing), str(seed), str(warmup_collisions(n)), str(collisions), backend]
+    warmup = warmup_collisions(n) if engine == "event-driven" else 5
+    args = [str(tree), str(n), repr(packing), str(seed), str(warmup), str(collisions), backend, repr(FRAME_DT)]
+    probe = _PROBE if engine == "event-driven" else _FRAME_PROBE
     done = subprocess.run(
-        [sys.executable, "-c", _PROBE, *args], cwd=workdir, env=env, capture_output=True, text=True, check=False
+        [sys.executable, "-c", probe, *args], cwd=workdir, env=env, capture_output=True, text=True, check=False
     )
     if done.returncode:
         msg = f"the timed run of {tree} at N={n} phi={packing} seed={seed} failed:\n{done.stderr}"
@@ -264,12 +289,14 @@ def run_pairs(base: Path, options: dict, scratch: Path) -> list[dict]:
         for n, phi in points:
             rates = {}
             for side in order:
-                result = measure(trees[side], n, phi, repeat, options["collisions"], scratch, options["backend"])
+                result = measure(
+                    trees[side], n, phi, repeat, options["collisions"], scratch, options["backend"], options["engine"]
+                )
                 rates[side] = result["collisions_per_s"]
             ratio = rates["new"] / rates["base"]
             announce(
                 f"  repeat {repeat + 1}/{options['repeats']} N={n:,} phi={phi:g} ({' then '.join(order)}): "
-                f"base {rates['base']:,.0f}, new {rates['new']:,.0f} coll/s, new/base {ratio:.3f}"
+                f"base {rates['base']:,.0f}, new {rates['new']:,.0f} {options['rate']}, new/base {ratio:.3f}"
             )
             pairs[n, phi].append(rates)
     return [summarise(pairs[point], *point) for point in points]
@@ -329,6 +356,12 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument(
         "--compile", action="store_true", help="time numba's cold and warm starts instead (--repeats pairs)"
     )
+    parser.add_argument(
+        "--engine",
+        choices=("event-driven", "fixed-step"),
+        default="event-driven",
+        help="EventDriven collisions/s (default) or FixedStep frames/s (--collisions counts frames then)",
+    )
     args = parser.parse_args(argv)
     defaults = QUICK if args.quick else FULL
     for key, value in defaults.items():
@@ -351,7 +384,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
     if args.compile:
         return compile_main(args)
-    options = {key: getattr(args, key) for key in (*FULL, "backend")}
+    options = {key: getattr(args, key) for key in (*FULL, "backend", "engine")}
+    options["rate"] = "coll/s" if args.engine == "event-driven" else "frames/s"
     labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE), "backend": args.backend}
     print(f"discsim A/B throughput; {machine_summary()}")
     print(f"base: {args.base} ({labels['base_label']}); new: {NEW_TREE} ({labels['new_label']})")
@@ -365,10 +399,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         rows = run_pairs(args.base, options, Path(scratch))
     for row in rows:
         row.update(labels)
-    print(format_table(rows, COLUMNS))
-    stem = "ab_throughput" if args.backend == "python" else f"ab_throughput_{args.backend}"
+    columns = [Column(c.key, c.title.replace("coll/s", options["rate"]), c.fmt) for c in COLUMNS]
+    print(format_table(rows, columns))
+    stem = "ab_throughput" if args.engine == "event-driven" else "ab_frames"
+    stem = stem if args.backend == "python" else f"{stem}_{args.backend}"
     csv_path = write_csv(args.out / f"{stem}.csv", rows, CSV_KEYS)
-    title = f"discsim EventDriven ({args.backend}): {labels['new_label']} / {labels['base_label']}"
+    engine = "EventDriven" if args.engine == "event-driven" else "FixedStep"
+    title = f"discsim {engine} ({args.backend}): {labels['new_label']} / {labels['base_label']}"
     png = plot(rows, args.out / f"{stem}.png", title)
     print(f"wrote {csv_path}, {png}")
     return 0

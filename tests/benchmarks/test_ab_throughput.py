@@ -82,3 +82,11 @@ def test_quick_run_of_the_compiled_loop(ab_throughput, tmp_path):
     with open(tmp_path / "ab_throughput_numba.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == 1 and rows[0]["backend"] == "numba" and float(rows[0]["new_median"]) > 0
+
+
+def test_fixed_step_mode_times_frames(ab_throughput, tmp_path):
+    argv = ["--quick", "--engine", "fixed-step", "--collisions", "20", "--base", str(REPO), "--out", str(tmp_path)]
+    assert ab_throughput.main(argv) == 0
+    with open(tmp_path / "ab_frames.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 1 and float(rows[0]["new_median"]) > 0 and rows[0]["backend"] == "python"

@@ -33,7 +33,7 @@ import numpy as np
 
 from discsim.cells import neighbour_pairs
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, WrongTypeError
-from discsim.model import OVERLAP_TOLERANCE, Box, Discs, normalize_pass_through
+from discsim.model import OVERLAP_TOLERANCE, Box, Discs, minimum_image_1d, normalize_pass_through
 from discsim.scene import check_segments, filter_table
 
 __all__ = ["REPAIRS", "STOP", "Repair", "Violations", "push_apart", "restart_scene", "violations"]
@@ -301,8 +301,7 @@ class _Pairs:
             xb, yb = pos[b].tolist()
             dx, dy = xb - xa, yb - ya
             if periodic:
-                dx -= width * round(dx / width)
-                dy -= height * round(dy / height)
+                dx, dy = minimum_image_1d(dx, width), minimum_image_1d(dy, height)
             dist = math.hypot(dx, dy)
             depth = sigma - dist
             if depth <= 0.0:  # parted by an earlier push in this sweep

@@ -8,7 +8,9 @@ and ``prefetch`` does nothing, so that doctest collection and the pure-Python pa
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Mapping
 from types import FunctionType
+from typing import Any, cast
 
 from discsim._numba import numba
 
@@ -59,7 +61,11 @@ else:
         return types.void(array, offset), codegen
 
 
-def compile_from_source(functions, decorate, replace=None):
+def compile_from_source(
+    functions: Iterable[Callable[..., Any]],
+    decorate: Callable[[FunctionType], Callable[..., Any]],
+    replace: Mapping[Callable[..., Any], Callable[..., Any]] | None = None,
+) -> dict[Callable[..., Any], Callable[..., Any]]:
     """Compile plain Python functions with ``decorate`` (``jit`` or ``inline``), from their very source.
 
     Each function is rebuilt over a copy of its own module's globals in which every function compiled before it
@@ -82,9 +88,9 @@ def compile_from_source(functions, decorate, replace=None):
     replace = replace or {}
     if _nb is None:
         return {function: replace.get(function, function) for function in functions}
-    compiled: dict = {}
+    compiled: dict[Callable[..., Any], Callable[..., Any]] = {}
     for function in functions:
-        source = replace.get(function, function)
+        source = cast(FunctionType, replace.get(function, function))  # plain Python functions, as documented
         table = dict(source.__globals__)
         for name, value in table.items():
             if isinstance(value, FunctionType):

@@ -15,7 +15,7 @@ class _Bar:
     def __init__(self, total, by_time: bool, unit: str = "events", rate: str | None = "collisions"):
         self._start = time.perf_counter()
         self._rate_name = rate
-        self._collisions0 = None
+        self._collisions0: int | None = None  # set by start(), or by the first update()
         self._by_time = by_time
         try:
             from tqdm.auto import tqdm

@@ -29,11 +29,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, COLLISION, EVENT_DTYPE, REMOVE
+
+if TYPE_CHECKING:
+    from discsim.model import Box
 
 __all__ = ["COLOUR_MODES", "DEFAULT_MAX_EVENTS", "View", "view"]
 
@@ -57,7 +61,7 @@ class _Run:
     radii: np.ndarray
     masses: np.ndarray
     groups: np.ndarray
-    box: object
+    box: Box
     segments: tuple
     positions0: np.ndarray
     velocities0: np.ndarray

@@ -233,7 +233,9 @@ def _collisions(events: np.ndarray):
 
 def _match(truth_by_pair, approx_by_pair, window: float):
     """Greedy nearest-time matching within each pair; returns matches, missed, spurious."""
-    matches, missed, spurious = [], [], []
+    matches: list[tuple[tuple[int, int], tuple[float, int], tuple[float, int]]] = []  # pair, (time, row) twice
+    missed: list[tuple[int, int, float]] = []  # i, j, time
+    spurious: list[tuple[int, int, float]] = []
     for pair in sorted(set(truth_by_pair) | set(approx_by_pair)):
         tt = truth_by_pair.get(pair, [])
         ta = approx_by_pair.get(pair, [])

@@ -111,18 +111,19 @@ def states_at(events: np.ndarray, positions0, velocities0, time0: float, times, 
     velocities0 = np.asarray(velocities0, dtype=float)
     unwrapped = reconstruct(events, positions0, velocities0, time0, times, box, unwrapped=True)
     n = len(positions0)
-    disc, t_rec, seq, vel = [np.arange(n)], [np.full(n, float(time0))], [np.full(n, -1)], [velocities0]
+    # Each disc's records: its state at time0, then the log's rows that name it (as i, then as j).
+    discs, t_recs, seqs, vels = [np.arange(n)], [np.full(n, float(time0))], [np.full(n, -1)], [velocities0]
     if len(events):
-        disc.append(events["i"])
-        t_rec.append(events["time"])
-        seq.append(np.arange(len(events)))
-        vel.append(np.column_stack([events["vxi"], events["vyi"]]))
+        discs.append(events["i"])
+        t_recs.append(events["time"])
+        seqs.append(np.arange(len(events)))
+        vels.append(np.column_stack([events["vxi"], events["vyi"]]))
         pair = np.flatnonzero(events["j"] >= 0)
-        disc.append(events["j"][pair])
-        t_rec.append(events["time"][pair])
-        seq.append(pair)
-        vel.append(np.column_stack([events["vxj"][pair], events["vyj"][pair]]))
-    disc, t_rec, seq, vel = np.concatenate(disc), np.concatenate(t_rec), np.concatenate(seq), np.vstack(vel)
+        discs.append(events["j"][pair])
+        t_recs.append(events["time"][pair])
+        seqs.append(pair)
+        vels.append(np.column_stack([events["vxj"][pair], events["vyj"][pair]]))
+    disc, t_rec, seq, vel = np.concatenate(discs), np.concatenate(t_recs), np.concatenate(seqs), np.vstack(vels)
     order = np.lexsort((seq, t_rec, disc))  # by disc, then time, then log order (as reconstruct)
     t_rec, vel = t_rec[order], vel[order]
     starts = np.searchsorted(disc[order], np.arange(n))

@@ -369,6 +369,7 @@ def psi6(positions, box: Box, *, k: int | None = 6, cutoff: float | None = None)
         if cutoff is not None:
             i, _, d = _bonds(frame, box, cutoff)
         else:
+            assert k is not None  # an int: checked above, when there is no cutoff
             i, _, d = _nearest(frame, box, k, limit)
         bond = np.exp(6j * np.arctan2(d[:, 1], d[:, 0]))
         counts[f] = np.bincount(i, minlength=n)

@@ -41,7 +41,7 @@ from __future__ import annotations
 import dataclasses
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from typing import ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -134,10 +134,13 @@ class EngineState:
     """
 
     VERSION: ClassVar[int] = 1
+    #: Declared for type checkers only (no value here): every subclass is a ``@dataclass``, which sets it.
+    __dataclass_fields__: ClassVar[dict[str, dataclasses.Field[Any]]]
 
     def to_arrays(self) -> tuple[dict, dict[str, np.ndarray]]:
         """``(scalars, arrays)``: the JSON-able fields and the numpy fields, by name."""
-        scalars, arrays = {}, {}
+        scalars: dict[str, Any] = {}
+        arrays: dict[str, np.ndarray] = {}
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
             (arrays if isinstance(value, np.ndarray) else scalars)[field.name] = value
@@ -384,7 +387,8 @@ class Engine(DiscEditing, EventRecord, ABC):
             ([[-0.5, 0.0], [0.5, 0.0]], [[-1.0, 0.0], [1.0, 0.0]])
         """
         discs, box, segments, pass_through, report = restart_scene(source, box, segments, pass_through, repair)
-        sim = cls(discs, box, segments=segments, pass_through=pass_through, **options)
+        build = cast("Callable[..., Engine]", cls)  # a concrete engine: (discs, box, *, segments, ...), not __init__
+        sim = build(discs, box, segments=segments, pass_through=pass_through, **options)
         sim.repair = report
         return sim
 

@@ -16,6 +16,7 @@ Example:
 
 from __future__ import annotations
 
+from os import PathLike
 from pathlib import Path
 
 import numpy as np
@@ -128,13 +129,13 @@ class EventStream(Observer):
 
     wants_events = True
 
-    def __init__(self, path):
+    def __init__(self, path: str | PathLike[str]) -> None:
         self.path = Path(path)
-        self._writer: RecordWriter | None = None
+        self._writer: RecordWriter | None = None  # opened by start(); flush, sync and finish come after it
         self._pending: list[np.ndarray] = []
         self._held = 0
         self._created = False
-        self._time = None  # the engine's time after the last chunk handed over
+        self._time: float | None = None  # the engine's time after the last chunk handed over
 
     def check(self, engine, plan) -> None:
         context = engine.run_context
@@ -221,18 +222,20 @@ class EventStream(Observer):
 
     def flush(self, engine) -> None:
         """Write the events held as one chunk, stamped with the time it covers up to."""
-        context = engine.run_context
+        context, writer = engine.run_context, self._writer
+        assert writer is not None, "start() opens the writer"
         records = np.concatenate(self._pending) if self._pending else np.zeros(0, dtype=EVENT_DTYPE)
         self._pending, self._held = [], 0
         try:
-            self._writer.append(records, {"time": engine.time if self._time is None else self._time})
+            writer.append(records, {"time": engine.time if self._time is None else self._time})
         except OSError as exc:  # a full disk, say: these events are lost to the log; say so if asked again
             context.stream = {**context.stream, "write_error": f"{type(exc).__name__}: {exc}"}
             raise
-        context.stream = {**context.stream, "records": self._writer.records, "end": self._writer.end}
+        context.stream = {**context.stream, "records": writer.records, "end": writer.end}
 
     def sync(self) -> None:
         """Force what was written to disk."""
+        assert self._writer is not None, "start() opens the writer"
         self._writer.sync()
 
     def finish(self, engine, completed) -> None:
@@ -240,6 +243,7 @@ class EventStream(Observer):
             if completed or self._held:  # the chunks handed over were processed whole: keep them
                 self.flush(engine)
         finally:
+            assert self._writer is not None, "start() opens the writer"
             self._writer.close()
 
     def undo_start(self) -> None:

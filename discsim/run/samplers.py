@@ -15,6 +15,7 @@ engine's own stops are not changed, so a sampled run gives the same events, bit 
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 
@@ -73,16 +74,18 @@ class Sampler(Observer):
         self.free_time_walls = bool(walls)
         self._collect_free = bool(free_times)
         self._parts: list[Frames] = []
-        self._engine_id = None
-        self._origin = None
+        # None until start() (the first run): update() and _sample() come only after it.
+        self._engine_id: int | None = None
+        self._origin: float | None = None
         self._next = 0  # index of the next sample time
-        self._state = None  # (time, unwrapped positions, velocities) where the next chunk starts
-        self._units = None
+        # (time, unwrapped positions, velocities) where the next chunk starts
+        self._state: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._units: int | None = None
         self.virial_blocks: VirialBlocks | None = None
         self._free: list[np.ndarray] = []
         self._free_discs: list[np.ndarray] = []
         self._free_starts: list[np.ndarray] = []
-        self._last = None
+        self._last: np.ndarray | None = None
 
     # --- results --------------------------------------------------------------------------
     @property
@@ -132,9 +135,9 @@ class Sampler(Observer):
         self._structure = engine.run_context.structure
         if self._engine_id is None:
             self._engine_id = id(engine)
-            self._origin = engine.time
+            self._origin = origin = engine.time
             masses = np.asarray(engine.discs.masses, dtype=float)
-            self.virial_blocks = VirialBlocks(self._origin, self.dt / 8, masses, engine.box, engine.kinetic_energy())
+            self.virial_blocks = VirialBlocks(origin, self.dt / 8, masses, engine.box, engine.kinetic_energy())
             self._last = np.full(len(engine.discs), np.nan)
         self._state = (engine.time, engine.unwrapped_positions, engine.velocities)
         self._units = engine._units()
@@ -147,10 +150,11 @@ class Sampler(Observer):
         changed = np.flatnonzero((events["kind"] == ADD) | (events["kind"] == REMOVE))
         if len(changed):  # a callback changed the discs: the samples after it would be wrong
             raise InvalidArgumentError(self._changed_message(float(events["time"][changed[0]])))
-        self.virial_blocks.add(events, engine.time)
+        blocks, last = self.virial_blocks, self._last
+        assert blocks is not None and last is not None, "start() comes before update()"
+        blocks.add(events, engine.time)
         if self._collect_free:
-            masses = self.virial_blocks.masses
-            times, discs, starts, self._last = free_times_of(events, self._last, masses, self.free_time_walls)
+            times, discs, starts, self._last = free_times_of(events, last, blocks.masses, self.free_time_walls)
             if len(times):
                 self._free.append(times)
                 self._free_discs.append(discs)
@@ -162,13 +166,15 @@ class Sampler(Observer):
     # --- sampling -----------------------------------------------------------------------------
     def sample_times(self, until: float) -> np.ndarray:
         """The sample times not yet taken, up to ``until``."""
-        last = math.floor((until - self._origin) / self.dt * (1 + 1e-12) + 1e-9)
+        origin = cast(float, self._origin)  # None only before the first run, where this raises TypeError as it did
+        last = math.floor((until - origin) / self.dt * (1 + 1e-12) + 1e-9)
         if last < self._next:
             return np.zeros(0)
         k = np.arange(self._next, last + 1)
-        return self._origin + k * self.dt
+        return origin + k * self.dt
 
     def _sample(self, engine, events) -> None:
+        assert self._state is not None, "start() comes before update()"
         t0, unwrapped0, velocities0 = self._state
         now = engine.time
         times = self.sample_times(now)

@@ -44,6 +44,11 @@ from discsim.errors import InvalidArgumentError, WrongTypeError
 
 if TYPE_CHECKING:
     from concurrent.futures import Future, ProcessPoolExecutor
+    from types import ModuleType
+
+    from pandas import DataFrame
+
+    from discsim.run.cache import SweepCache
 
 __all__ = ["ERROR_COLUMN", "SEED_COLUMN", "grid_points", "seed_streams", "sweep", "task_name"]
 
@@ -317,7 +322,9 @@ class _Finished:
     (Waiting on all unfinished futures after each completion would cost O(tasks) each time.)
     """
 
-    def __init__(self):
+    label: str  # where the tasks run, for the table's attrs (set by each subclass)
+
+    def __init__(self) -> None:
         import queue
 
         self._done: queue.SimpleQueue[Future] = queue.SimpleQueue()
@@ -589,7 +596,16 @@ def _run(pd, task, name, jobs, executor, store, retries, progress):
     return _table(pd, name, jobs, executor, store, resubmitted, time.perf_counter() - start, retries)
 
 
-def _table(pd, name, jobs, executor, store, resubmitted, seconds, retries):
+def _table(
+    pd: ModuleType,
+    name: str,
+    jobs: list[_Job],
+    executor: _InProcess | _Finished,
+    store: SweepCache | None,
+    resubmitted: int,
+    seconds: float,
+    retries: int,
+) -> DataFrame:
     columns = [*jobs[0].params, SEED_COLUMN]
     results: dict[str, None] = {}  # the result keys of every job, in the order first seen
     for job in jobs:

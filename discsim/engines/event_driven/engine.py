@@ -17,7 +17,7 @@ from discsim.cells import CellGrid, neighbour_pairs
 from discsim.engines.base import Engine, register_engine
 from discsim.engines.event_driven.numba import NumbaBackend
 from discsim.engines.event_driven.numbering import fresh_state
-from discsim.engines.event_driven.protocol import Backend
+from discsim.engines.event_driven.protocol import BackendClass
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError, JammedError
@@ -28,8 +28,10 @@ from discsim.scene import Scene
 __all__ = ["BACKENDS", "EventDriven"]
 
 INF = math.inf
-#: The backends of the event loop, by name: each meets :class:`~discsim.engines.event_driven.protocol.Backend`.
-BACKENDS: dict[str, type[Backend]] = {"python": PythonBackend, "numba": NumbaBackend}
+#: The backends of the event loop, by name: each meets :class:`~discsim.engines.event_driven.protocol.Backend`
+#: (the type checker checks both classes against it, through
+#: :class:`~discsim.engines.event_driven.protocol.BackendClass`).
+BACKENDS: dict[str, BackendClass] = {"python": PythonBackend, "numba": NumbaBackend}
 
 
 @register_engine
@@ -249,7 +251,12 @@ class EventDriven(Engine):
                 return done  # the event limit, or nothing left in the queue
             if k == 0:
                 if self._never_again():
-                    self.time = backend.last_event()[0] if done else start
+                    if done:
+                        last = backend.last_event()
+                        assert last is not None  # done > 0: events were processed
+                        self.time = last[0]
+                    else:
+                        self.time = start
                     return done
                 budget *= 2
 
@@ -453,7 +460,9 @@ class EventDriven(Engine):
         self._check_usable()
         if self._advance(INF, 1) == 0:
             return None
-        t, kind, i, j = self._backend.last_event()
+        last = self._backend.last_event()
+        assert last is not None  # the event just processed
+        t, kind, i, j = last
         return Event(t, KIND_NAMES[kind], i, j)
 
     def _check(self) -> None:

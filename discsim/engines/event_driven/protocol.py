@@ -6,14 +6,18 @@ A backend runs the event loop on its own internal forms; what crosses its edge i
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EventLog
 
-__all__ = ["Backend"]
+if TYPE_CHECKING:
+    from discsim.cells import CellGrid
+    from discsim.scene import Scene
+
+__all__ = ["Backend", "BackendClass"]
 
 
 @runtime_checkable
@@ -23,14 +27,16 @@ class Backend(Protocol):
     Attributes:
         name: the backend's name (``EventDriven(..., backend=name)``).
         time: the current simulated time (the front class sets it when a run stops on time).
-        max_queue: most events pending at once. max_overlap: deepest overlap at a contact
+        max_queue: most events pending at once (read only). max_overlap: deepest overlap at a contact
             (settable). virial: sum over collisions of ``dp_i . (r_i - r_j)``.
     """
 
     name: str
     time: float
-    max_queue: int
     max_overlap: float
+
+    @property
+    def max_queue(self) -> int: ...
 
     @property
     def virial(self) -> float: ...
@@ -79,3 +85,12 @@ class Backend(Protocol):
 
     def _check(self) -> None:
         """Assert the backend's own invariants."""
+
+
+class BackendClass(Protocol):
+    """What builds a backend: ``BACKENDS[name](scene, grid, queue)``, a backend class (or any such factory).
+
+    The front class builds its backend through this call only; the backend is then started or loaded.
+    """
+
+    def __call__(self, scene: Scene, grid: CellGrid, queue: str) -> Backend: ...

@@ -216,7 +216,7 @@ class FixedStep(Engine):
             return shapes, broad, compiled_policy(self.policy, shapes, broad, self.bisect_tol)
         if self.policy == "bisect":
             return shapes, broad, Bisect(shapes, broad, self.bisect_tol)
-        return shapes, broad, _POLICY_CLASSES[self.policy](shapes, broad)
+        return shapes, broad, _POLICY_CLASSES[self.policy](shapes, broad)  # type: ignore[call-arg]  # not Bisect (above)
 
     def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None:
         """Go on with discs ``keep`` and then ``added`` (new at ``time``, as if set there: their frame

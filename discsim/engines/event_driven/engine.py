@@ -198,11 +198,12 @@ class EventDriven(Engine):
             vx, vy = velocities[k].tolist()
             set_disc(i, vx, vy, None if positions is None else tuple(positions[k].tolist()))
 
-    def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None:
+    def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene, last=None) -> None:
         """A fresh start at ``time`` from the discs of ``scene`` (``keep``, then ``added``): new cell grid, new
         backend, every disc predicted, as ``EventDriven(scene.discs, box)`` would start (its times then
         shifted by ``time``: the internal clock's epoch is ``time``). The counters, the virial and the
-        images of the kept discs (so ``unwrapped_positions`` stay continuous) carry over."""
+        images of the kept discs (so ``unwrapped_positions`` stay continuous) carry over, and ``last`` (the
+        backend's ``last_event()``, when the discs keep their numbers) as the last event."""
         old, box = self._backend, self.box
         grid = self.cell_grid(scene.discs.radii, box, self.cell_size)  # may refuse the new discs: nothing changed
         backend = BACKENDS[old.name](scene, grid, self.queue_kind)
@@ -211,6 +212,8 @@ class EventDriven(Engine):
         for name, value in old.counts().items():
             setattr(state, name, value)
         state.virial, state.max_overlap, state.max_queue = old.virial, old.max_overlap, old.max_queue
+        if last is not None:
+            state.last_time, state.last_kind, state.last_i, state.last_j = last
         if box.periodic and len(keep):
             unwrapped = old.unwrapped_positions()[keep]
             state.images[: len(keep)] = np.round((unwrapped - scene.discs.positions[: len(keep)]) / box.size)
@@ -251,14 +254,26 @@ class EventDriven(Engine):
                 return done  # the event limit, or nothing left in the queue
             if k == 0:
                 if self._never_again():
-                    if done:
-                        last = backend.last_event()
-                        assert last is not None  # done > 0: events were processed
-                        self.time = last[0]
-                    else:
-                        self.time = start
+                    last = backend.last_event() if done else None  # done > 0: there is one
+                    self._rewind(start if last is None else last[0])
                     return done
                 budget *= 2
+
+    def _rewind(self, time: float) -> None:
+        """Back to ``time``, after a proof that no disc will ever hit anything again (:meth:`_never_again`).
+
+        The discs have crossed cells since ``time``, so the clock alone cannot go back: each disc's cell would
+        be one it reaches only later, and after a change of course (``set_velocities``) the predictions would
+        scan the wrong neighbours and miss collisions. The backend starts afresh at ``time`` from the discs as
+        they are then (what ``EventDriven(sim.snapshot(), box)`` would do), keeping the counters, the virial,
+        the periodic images and the last event. O(N), once per proof.
+        """
+        old = self._backend
+        last = old.last_event()
+        old.time = time
+        now = self.snapshot()
+        scene = Scene(now, self.box, self.scene.segments, self.scene.pass_through, check=False)
+        self._restructure(np.arange(len(now)), None, scene, last)
 
     #: A run raises :class:`~discsim.errors.JammedError` after ``jam_events + jam_events_per_disc * N``
     #: physical events in a row at one instant: far more than a finite cascade of simultaneous collisions

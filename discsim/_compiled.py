@@ -8,13 +8,87 @@ and ``prefetch`` does nothing, so that doctest collection and the pure-Python pa
 
 from __future__ import annotations
 
+import functools
+import hashlib
 from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
 from types import FunctionType
 from typing import Any, cast
 
 from discsim._numba import numba
 
 __all__ = ["compile_from_source", "inline", "jit", "prefetch"]
+
+#: What every compiled function of discsim may compile into itself, besides its own folder's modules (the
+#: physics parts, the minimum image, the queue's heap, the event kinds, this module): paths under the package.
+DEPENDENCIES = ("physics", "model.py", "queue.py", "events.py", "_compiled.py")
+_PACKAGE = Path(__file__).resolve().parent
+
+
+def source_stamp(py_file) -> bytes:
+    """The stamp numba's cache keeps for a compiled function of ``py_file``: a hash of its folder's modules and of
+    :data:`DEPENDENCIES`.
+
+    numba checks a cached function against its own source file only, yet the loops compile the physics parts
+    into themselves (``inline``): with numba's own stamp, an edit of ``physics/dynamics.py`` would leave every
+    cached loop running the old law. Installed copies never change, so their cache stays valid; a developer's
+    edit of a part recompiles what depends on it.
+    """
+    folder = Path(py_file).resolve().parent
+    files = sorted({*folder.glob("*.py"), *(p for d in DEPENDENCIES for p in _files(_PACKAGE / d))})
+    return _hash_files(tuple((str(path), path.stat().st_mtime_ns, path.stat().st_size) for path in files))
+
+
+@functools.lru_cache(maxsize=64)
+def _hash_files(files: tuple[tuple[str, int, int], ...]) -> bytes:
+    """A hash of the files' names (under the package) and contents; memoized on their times and sizes, so the
+    many compiled functions of one process read each file once."""
+    digest = hashlib.sha256()
+    for name, _, _ in files:
+        path = Path(name)
+        digest.update(str(path.relative_to(_PACKAGE) if path.is_relative_to(_PACKAGE) else path).encode())
+        digest.update(path.read_bytes())
+    return digest.digest()
+
+
+def _files(path: Path) -> list[Path]:
+    if path.is_dir():
+        return sorted(path.rglob("*.py"))
+    return [path] if path.exists() else []
+
+
+def _install_cache_stamp(nb) -> None:
+    """Make numba stamp the cached functions of discsim's own files with :func:`source_stamp` (both where numba
+    puts its cache by default and under ``NUMBA_CACHE_DIR``); functions of other files keep numba's stamp.
+
+    Uses numba's cache locators (``numba.core.caching``); with a numba whose locators differ, nothing is
+    changed and numba's own stamp applies.
+    """
+    try:
+        from numba.core import caching
+
+        bases = (caching.UserProvidedCacheLocator, caching.InTreeCacheLocator)
+        locators = caching.CacheImpl._locator_classes
+    except (ImportError, AttributeError):
+        return
+
+    def stamped(base):
+        class Locator(base):
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                if not Path(py_file).resolve().is_relative_to(_PACKAGE):
+                    return None
+                return super().from_function(py_func, py_file)
+
+            def get_source_stamp(self):
+                return source_stamp(self._py_file)
+
+        Locator.__name__ = Locator.__qualname__ = f"Discsim{base.__name__}"
+        return Locator
+
+    if not any(k.__name__.startswith("Discsim") for k in locators):
+        locators[:0] = [stamped(base) for base in bases]
+
 
 _nb = numba()
 if _nb is None:
@@ -32,6 +106,7 @@ else:
     from numba.core import cgutils, types
     from numba.extending import intrinsic
 
+    _install_cache_stamp(_nb)
     # Cached on disk; no reference counts on array arguments (they cost 30% of the event loop's time);
     # error_model="numpy": a division by zero gives inf or nan instead of a check on every division (the
     # loops divide only by numbers they have tested, as the Python code does).

@@ -336,8 +336,9 @@ class Box:
 def minimum_image_1d(d: float, length: float) -> float:
     """One coordinate ``d`` of a displacement mapped to its nearest periodic image in a box ``length`` wide.
 
-    :meth:`Box.minimum_image` on one float, for the loops (numba compiles this very function into the compiled
-    ones): ``round`` rounds halves to even, as ``numpy.round`` does.
+    The rule of :meth:`Box.minimum_image` on one float, for the loops (numba compiles this very function into
+    the compiled ones): ``round`` rounds halves to even, as ``numpy.round`` does. It keeps the sign of a zero
+    (``-0.0`` stays ``-0.0``; the array form gives ``+0.0`` there), as the Python loop always did.
 
     Example:
         >>> minimum_image_1d(9.0, 10.0), minimum_image_1d(-6.0, 10.0)

@@ -86,3 +86,42 @@ def test_the_compiled_segment_kernels_equal_the_python_ones_bit_for_bit(px, py, 
     if math.hypot(px - cx, py - cy) > 1e-6:  # a disc's centre is never on a segment it bounces off
         expected = kernels.reflect_off_segment(px, py, vx, vy, ax, ay, bx, by)
         assert reflect_off_segment(px, py, vx, vy, ax, ay, bx, by) == expected
+
+
+def test_the_cache_stamp_of_a_compiled_module_covers_the_parts_compiled_into_it(tmp_path, monkeypatch):
+    # numba checks a cached function against its own file only; the loops compile the physics parts into
+    # themselves, so their stamp must change when a part does (else an edited law runs the old machine code).
+    from discsim import _compiled
+
+    package = tmp_path / "pkg"
+    for folder in ("physics", "engine", "other"):
+        (package / folder).mkdir(parents=True)
+    part, loop, sibling, unrelated = (
+        package / "physics" / "dynamics.py",
+        package / "engine" / "loop.py",
+        package / "engine" / "kernels.py",
+        package / "other" / "plot.py",
+    )
+    for path in (part, loop, sibling, unrelated):
+        path.write_text("x = 1\n")
+    monkeypatch.setattr(_compiled, "_PACKAGE", package)
+    stamps = [_compiled.source_stamp(loop)]
+    part.write_text("x = 22\n")  # a part the loop compiles in
+    stamps.append(_compiled.source_stamp(loop))
+    sibling.write_text("x = 333\n")  # a module of the loop's own folder
+    stamps.append(_compiled.source_stamp(loop))
+    unrelated.write_text("x = 4444\n")  # neither
+    stamps.append(_compiled.source_stamp(loop))
+    assert stamps[0] != stamps[1] != stamps[2] == stamps[3]
+
+
+@needs_numba
+def test_discsim_files_get_the_discsim_cache_stamp():
+    from numba.core import caching
+
+    import discsim._compiled  # noqa: F401  (installs the locators)
+
+    names = [k.__name__ for k in caching.CacheImpl._locator_classes]
+    assert names[:2] == ["DiscsimUserProvidedCacheLocator", "DiscsimInTreeCacheLocator"]
+    locator = caching.CacheImpl._locator_classes[1]
+    assert locator.from_function(caching.CacheImpl.__init__, caching.__file__) is None  # not discsim's: numba's

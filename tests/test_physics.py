@@ -8,6 +8,7 @@ here each part is held to exact values and its compiled form to its Python form.
 from __future__ import annotations
 
 import math
+import struct
 
 import numpy as np
 import pytest
@@ -75,6 +76,27 @@ def test_the_scalar_minimum_image_is_the_box_rule(d, length):
     assert minimum_image_1d(d, length) == box.minimum_image(np.array([d, d]))[0]
 
 
+def test_the_scalar_minimum_image_keeps_the_sign_of_a_zero_as_the_loops_always_did():
+    # Python's round(-0.0) is the int 0: -0.0 - L * 0 stays -0.0 (the Python backend's old inline formula did
+    # the same; numpy's round gives -0.0 and so +0.0 in Box.minimum_image, which no loop uses).
+    assert _bits(minimum_image_1d(-0.0, 10.0)) == _bits(-0.0)
+    assert minimum_image_1d(5.0, 10.0) == 5.0 and minimum_image_1d(15.0, 10.0) == -5.0  # halves to even
+
+
+def _bits(x) -> bytes:
+    """The float's 8 bytes: ``==`` cannot tell -0.0 from 0.0, and bit for bit means both."""
+    return struct.pack("<d", x)
+
+
+def _same(a, b) -> bool:
+    """Bit for bit, element by element (floats, ints, or tuples of them)."""
+    if isinstance(a, tuple):
+        return isinstance(b, tuple) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) or isinstance(b, float):
+        return _bits(float(a)) == _bits(float(b)) and type(a) is type(b)
+    return a == b
+
+
 @given(coordinate, coordinate, speed, speed, speed, speed, radius, radius, st.floats(0.0, 3.0))
 def test_pair_predict_is_free_flight_then_the_time_of_impact(x, y, vxj, vyj, vxi, vyi, ri, rj, dtj):
     xj, yj = x + 0.5, y - 0.25
@@ -119,24 +141,24 @@ def test_laws_reflect_and_segments_are_the_kernels():
 def test_the_compiled_parts_equal_the_python_parts_bit_for_bit(x, y, vxj, vyj, vxi, vyi, ri, rj, dtj, periodic):
     from discsim.physics import compiled
 
-    same = lambda a, b: a == b or (a != a and b != b)  # noqa: E731
-    assert compiled.advance(x, y, vxi, vyi, dtj) == dynamics.advance(x, y, vxi, vyi, dtj)
+    assert _same(compiled.advance(x, y, vxi, vyi, dtj), dynamics.advance(x, y, vxi, vyi, dtj))
     for lo, hi in ((x - 1.0, x + 2.0), (x + 0.5, x - 0.5)):
-        assert compiled.exit_x(x, vxi, lo, hi) == dynamics.exit_x(x, vxi, lo, hi)
-        assert compiled.exit_y(y, vyi, lo, hi) == dynamics.exit_y(y, vyi, lo, hi)
+        assert _same(compiled.exit_x(x, vxi, lo, hi), dynamics.exit_x(x, vxi, lo, hi))
+        assert _same(compiled.exit_y(y, vyi, lo, hi), dynamics.exit_y(y, vyi, lo, hi))
         for walls in ((False, False), (True, False), (False, True), (True, True)):
             got = compiled.predict_x(x, vxi, ri, lo, hi, 40.0, *walls)
-            assert got == boundaries.predict_x(x, vxi, ri, lo, hi, 40.0, *walls)
+            assert _same(got, boundaries.predict_x(x, vxi, ri, lo, hi, 40.0, *walls))
             got = compiled.predict_y(y, vyi, ri, lo, hi, 40.0, *walls)
-            assert got == boundaries.predict_y(y, vyi, ri, lo, hi, 40.0, *walls)
+            assert _same(got, boundaries.predict_y(y, vyi, ri, lo, hi, 40.0, *walls))
     args = (x + 1.0, y - 0.5, vxj, vyj, dtj, rj, -x, -y, vxi, vyi, ri)
-    assert compiled.pair_predict(*args) == pairs.predict(*args)
+    assert _same(compiled.pair_predict(*args), pairs.predict(*args))
     dx, dy = x + 2.5 * ri, y - 0.3 * rj
-    assert compiled.pair_time_of_impact(dx, dy, vxj, vyj, ri) == dynamics.pair_time_of_impact(dx, dy, vxj, vyj, ri)
+    assert _same(compiled.pair_time_of_impact(dx, dy, vxj, vyj, ri), dynamics.pair_time_of_impact(dx, dy, vxj, vyj, ri))
     state = (x, y, vxi, vyi, 1.0, x + ri + rj, y + 0.1, vxj, vyj, 2.5, 30.0, 20.0, periodic)
-    assert all(same(a, b) for a, b in zip(compiled.pair_resolve(*state), pairs.resolve(*state)))
-    assert compiled.minimum_image_1d(dx, 7.0) == minimum_image_1d(dx, 7.0)
-    assert compiled.reflect(vxi, vyi, 0) == laws.reflect(vxi, vyi, 0)
-    assert compiled.wall_time(x, vxi, ri, 40.0) == boundaries.wall_time(x, vxi, ri, 40.0)
+    assert _same(compiled.pair_resolve(*state), pairs.resolve(*state))
+    for d in (dx, -dx, 0.0, -0.0, 3.5, -3.5, 10.5):
+        assert _same(compiled.minimum_image_1d(d, 7.0), minimum_image_1d(d, 7.0))
+    assert _same(compiled.reflect(vxi, vyi, 0), laws.reflect(vxi, vyi, 0))
+    assert _same(compiled.wall_time(x, vxi, ri, 40.0), boundaries.wall_time(x, vxi, ri, 40.0))
     for direction in (PLUS_X, MINUS_X, PLUS_Y, MINUS_Y):
         assert compiled.cross(2, 0, direction, 3, 4) == boundaries.cross(2, 0, direction, 3, 4)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from discsim import model
 from discsim._compiled import compile_from_source, inline
+from discsim._numba import numba
 from discsim.physics import dynamics, laws
 from discsim.physics.sources import boundaries, pairs
 
@@ -83,7 +84,13 @@ def compile_parts(law_of_motion=None, collision_law=None) -> dict:
         replace.update({getattr(dynamics, name): getattr(law_of_motion, name) for name in DYNAMICS})
     if collision_law is not None:
         replace.update({getattr(laws, name): getattr(collision_law, name) for name in LAWS})
-    compiled = compile_from_source(_SOURCES, inline, replace)
+    decorate = inline
+    nb = numba()
+    if replace and nb is not None:
+        # Not cached on disk: numba would file these under the very names of the free-flight parts (its cache
+        # knows a function by its source file and name, not by the parts compiled into it).
+        decorate = nb.njit(cache=False, nogil=True, error_model="numpy", _nrt=False, inline="always")
+    compiled = compile_from_source(_SOURCES, decorate, replace)
     return {name: compiled[source] for name, source in _NAMES.items()}
 
 

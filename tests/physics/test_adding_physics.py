@@ -55,13 +55,14 @@ wind = SimpleNamespace(
 # --8<-- [end:law]
 
 
-def _run(discs, box, events, law_of_motion=None):
-    """The first ``events`` collisions of the compiled loop over ``law_of_motion``: the log as an array."""
+def _run(discs, box, events, law_of_motion=None, collision_law=None):
+    """The compiled loop over the given laws, its first ``events`` physical events: the backend and its log."""
     from discsim.engines.event_driven.engine import EventDriven
     from discsim.engines.event_driven.numba.backend import NumbaBackend
 
     scene = Scene(discs, box)
-    backend = NumbaBackend(scene, EventDriven.cell_grid(discs.radii, box), "calendar", law_of_motion=law_of_motion)
+    grid = EventDriven.cell_grid(discs.radii, box)
+    backend = NumbaBackend(scene, grid, "calendar", law_of_motion=law_of_motion, collision_law=collision_law)
     backend.start()
     log = EventLog()
     backend.advance(math.inf, events, log)
@@ -102,10 +103,63 @@ def test_a_gas_in_a_wind_is_the_same_gas_seen_from_a_moving_frame():
     np.testing.assert_allclose(windy.positions(), still.positions(), atol=1e-8)
 
 
+def test_every_function_that_reaches_a_part_is_rebuilt():
+    # with_physics swaps parts by name in the functions of PHYSICAL: a function of the loop that calls a part,
+    # itself or through another function, and is not in that list would keep free flight.
+    from discsim.engines.event_driven.numba import loop
+    from discsim.physics.compiled import _NAMES
+
+    functions = {
+        name: f.py_func
+        for name, f in vars(loop).items()
+        if hasattr(f, "py_func") and f.py_func.__module__ == loop.__name__  # the loop's own, not the parts
+    }
+    calls = {name: set(f.__code__.co_names) for name, f in functions.items()}
+    reaching = {name for name, names in calls.items() if names & set(_NAMES)}
+    while True:
+        more = {name for name, names in calls.items() if names & reaching} - reaching
+        if not more:
+            break
+        reaching |= more
+    assert reaching == set(loop.PHYSICAL)
+
+
+@pytest.mark.slow  # compiles the event loop anew (once for the three scenes)
+def test_the_loop_compiled_over_free_flight_and_the_elastic_law_is_the_usual_loop_bit_for_bit():
+    # with_physics over the free-flight and elastic modules themselves: the same events, to the last bit, in a
+    # walled box with segments, in a periodic box (crossings through the edges, the minimum image), and after a
+    # change of course (set_disc).
+    from discsim.physics import laws
+
+    walled = ds.random_gas(200, 0.5, periodic=False, seed=2)
+    periodic = ds.random_gas(300, 0.4, periodic=True, seed=3)
+    for discs, box in (walled, periodic):
+        rebuilt, log = _run(discs, box, 1000, law_of_motion=dynamics, collision_law=laws)
+        usual, reference = _run(discs, box, 1000)
+        assert log.tobytes() == reference.tobytes()
+        for backend in (rebuilt, usual):
+            backend.set_disc(7, 0.5, -1.25)
+        logs = []
+        for backend in (rebuilt, usual):
+            more = EventLog()
+            backend.advance(math.inf, 500, more)
+            logs.append(more.to_array().tobytes())
+        assert logs[0] == logs[1]
+        assert rebuilt.positions().tobytes() == usual.positions().tobytes()
+
+
 @pytest.mark.slow  # compiles the event loop anew
-def test_the_loop_compiled_over_free_flight_is_the_usual_loop_bit_for_bit():
-    # with_physics over the free-flight module itself: the same machine code's events, to the last bit.
-    discs, box = ds.random_gas(200, 0.5, periodic=False, seed=2)
-    _, log = _run(discs, box, 1000, law_of_motion=dynamics)
-    _, reference = _run(discs, box, 1000)
-    assert log.tobytes() == reference.tobytes()
+def test_a_law_in_which_no_pair_ever_meets_gives_no_collision():
+    # Every part the loop calls comes from the law: discs that never meet (a toy pair time of impact) only
+    # cross cells and hit walls.
+    never = SimpleNamespace(**{name: getattr(dynamics, name) for name in ("advance", "exit_x", "exit_y")})
+    never.pair_time_of_impact = _never
+    never.segment_time_of_impact = dynamics.segment_time_of_impact
+    discs, box = ds.random_gas(200, 0.4, periodic=False, seed=1)
+    backend, log = _run(discs, box, 300, law_of_motion=never)
+    assert len(log) == 300 and backend.counts()["collisions"] == 0 and backend.counts()["wall_hits"] == 300
+
+
+def _never(dx, dy, dvx, dvy, sigma):
+    """A pair time of impact for discs that pass through each other."""
+    return math.inf

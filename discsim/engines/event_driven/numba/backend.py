@@ -280,9 +280,9 @@ class NumbaBackend:
         k = int(np.flatnonzero(self._order == i)[0])
         t = self.time - float(self._floats[lp.F_EPOCH])
         if position is None:
-            dt = t - float(rec[k, 4])
-            x = float(rec[k, 0]) + float(rec[k, 2]) * dt
-            y = float(rec[k, 1]) + float(rec[k, 3]) * dt
+            x, y, _, _ = self._law_of_motion.advance(
+                float(rec[k, 0]), float(rec[k, 1]), float(rec[k, 2]), float(rec[k, 3]), t - float(rec[k, 4])
+            )
             cell = int(self._cell[k])
         else:
             x, y = float(position[0]), float(position[1])
@@ -340,7 +340,10 @@ class NumbaBackend:
 
     def velocities(self) -> np.ndarray:
         """``(N, 2)`` velocities at ``time``."""
-        return self._rec[self._rank(), 2:4].copy()
+        t = self.time - float(self._floats[self._lp.F_EPOCH])
+        rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
+        _, _, vx, vy = self._law_of_motion.advance(rx, ry, vx, vy, t - tr)
+        return np.column_stack([vx, vy]).reshape(-1, 2)
 
     def last_event(self) -> tuple[float, int, int, int] | None:
         """``(time, kind, i, j)`` of the last physical event in the caller's numbering, or None."""

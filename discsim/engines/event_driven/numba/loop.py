@@ -614,6 +614,8 @@ def run_events(
 #: The functions above that call the physics parts (directly or through ``predict``), callees first: the ones
 #: :func:`with_physics` compiles anew.
 PHYSICAL = ("predict", "predict_all", "set_disc", "run_events")
+#: Loops compiled by :func:`with_physics`, by the identity of their laws (kept here, so the ids stay theirs).
+_BUILT: dict[tuple[int, int], tuple[object, object, dict]] = {}
 
 
 def with_physics(law_of_motion=None, collision_law=None) -> dict:
@@ -622,8 +624,9 @@ def with_physics(law_of_motion=None, collision_law=None) -> dict:
     The parts (:func:`discsim.physics.compiled.compile_parts`) are compiled over the given laws, and the
     functions of :data:`PHYSICAL` are compiled anew from their very source with those parts in place of free
     flight and the elastic law; the rest (queue, cells, prefetches) is shared. The new functions are compiled
-    in this process, not cached on disk (the cache knows a function by its own source file only, not by the
-    laws it was compiled over), which takes about as long as the first compile of this module.
+    in this process, once per pair of laws, and not cached on disk (numba's cache knows a function by its own
+    source file and name, not by the laws compiled into it): the first use takes about as long as the first
+    compile of this module.
 
     Args:
         law_of_motion: a module with the functions of :data:`discsim.physics.compiled.DYNAMICS` (None: free
@@ -640,6 +643,9 @@ def with_physics(law_of_motion=None, collision_law=None) -> dict:
     from discsim._numba import numba
     from discsim.physics.compiled import compile_parts
 
+    key = (id(law_of_motion), id(collision_law))
+    if key in _BUILT:
+        return _BUILT[key][2]
     nb = numba()
     namespace = dict(globals())
     namespace.update(compile_parts(law_of_motion, collision_law))
@@ -652,4 +658,5 @@ def with_physics(law_of_motion=None, collision_law=None) -> dict:
         rebuilt.__qualname__ = source.__qualname__
         options = {key: value for key, value in dispatcher.targetoptions.items() if key != "nopython"}
         namespace[name] = nb.njit(cache=False, **options)(rebuilt)
+    _BUILT[key] = (law_of_motion, collision_law, namespace)
     return namespace

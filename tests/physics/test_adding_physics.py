@@ -55,12 +55,12 @@ wind = SimpleNamespace(
 # --8<-- [end:law]
 
 
-def _run(discs, box, events, law_of_motion=None, collision_law=None):
+def _run(discs, box, events, law_of_motion=None, collision_law=None, segments=()):
     """The compiled loop over the given laws, its first ``events`` physical events: the backend and its log."""
     from discsim.engines.event_driven.engine import EventDriven
     from discsim.engines.event_driven.numba.backend import NumbaBackend
 
-    scene = Scene(discs, box)
+    scene = Scene(discs, box, segments)
     grid = EventDriven.cell_grid(discs.radii, box)
     backend = NumbaBackend(scene, grid, "calendar", law_of_motion=law_of_motion, collision_law=collision_law)
     backend.start()
@@ -131,11 +131,15 @@ def test_the_loop_compiled_over_free_flight_and_the_elastic_law_is_the_usual_loo
     # change of course (set_disc).
     from discsim.physics import laws
 
-    walled = ds.random_gas(200, 0.5, periodic=False, seed=2)
+    gas, walls = ds.random_gas(200, 0.4, periodic=False, seed=2)
+    wall = ds.Segment([0.25 * walls.width, 0.5 * walls.height], [0.75 * walls.width, 0.6 * walls.height])
+    clear = wall.distance(gas.positions) > gas.radii * 1.001  # the discs the segment does not cut
+    walled = ds.Discs(gas.positions[clear], gas.velocities[clear], gas.radii[clear])
     periodic = ds.random_gas(300, 0.4, periodic=True, seed=3)
-    for discs, box in (walled, periodic):
-        rebuilt, log = _run(discs, box, 1000, law_of_motion=dynamics, collision_law=laws)
-        usual, reference = _run(discs, box, 1000)
+    for discs, box, segments in ((walled, walls, [wall]), (*periodic, [])):
+        rebuilt, log = _run(discs, box, 1000, law_of_motion=dynamics, collision_law=laws, segments=segments)
+        usual, reference = _run(discs, box, 1000, segments=segments)
+        assert not segments or usual.counts()["wall_hits"] > 0
         assert log.tobytes() == reference.tobytes()
         for backend in (rebuilt, usual):
             backend.set_disc(7, 0.5, -1.25)

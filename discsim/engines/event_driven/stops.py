@@ -1,0 +1,220 @@
+"""How an event-driven run stops: at a time, after a count, when no disc can ever hit anything again, or jammed.
+
+:class:`RunStops` is the part of :class:`~discsim.engines.event_driven.engine.EventDriven` between the driver
+and the backend: ``_advance(until, limit)`` asks the backend for events in chunks, watching the clock for a
+jam (:class:`~discsim.errors.JammedError`, naming the wedged discs), and ends an open-ended run in a periodic
+box once it proves no pair will ever meet (``_never_again``), putting the clock and the cells back
+(``_rewind``). Any other exception inside the loop marks the engine unusable.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from discsim.cells import neighbour_pairs
+from discsim.engines.event_driven.protocol import Backend
+from discsim.errors import Interrupted, JammedError
+from discsim.model import Box, Discs
+from discsim.scene import Scene
+
+if TYPE_CHECKING:
+    from discsim.events import EventLog
+
+__all__ = ["RunStops"]
+
+INF = math.inf
+
+
+class RunStops:
+    """The stops of an event-driven run (a mixin of :class:`~discsim.engines.event_driven.engine.EventDriven`)."""
+
+    # What the engine provides (declared for readers and the type checker).
+    _backend: Backend
+    _broken: str | None
+    _logging: bool
+    _log: EventLog
+    box: Box
+    discs: Discs
+    scene: Scene
+    time: float
+
+    if TYPE_CHECKING:  # the engine's own methods, named for the type checker only (at run time they would
+        # come before the engine's in the method order)
+
+        def _units(self) -> int: ...
+        def snapshot(self) -> Discs: ...
+        def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene, last=None) -> None: ...
+
+        @property
+        def positions(self) -> np.ndarray: ...
+
+        @property
+        def velocities(self) -> np.ndarray: ...
+
+    def _advance(self, until: float, limit: int | None) -> int:
+        log = self._log if self._logging else None
+        try:
+            if until != INF:
+                return self._chunked(until, limit, log)
+            return self._advance_open(limit, log)
+        except (Interrupted, JammedError):  # raised between two whole events: the state is consistent
+            raise
+        except BaseException as exc:  # half-way through an event: the state cannot be trusted
+            self._broken = f"{type(exc).__name__} at time {self.time!r}"
+            raise
+
+    def _advance_open(self, limit: int | None, log) -> int:
+        """:meth:`_advance` with no time limit: also stop when no disc can ever hit anything again.
+
+        In a periodic box, discs that never meet cross cells forever. The loop
+        therefore returns after ``budget`` cell crossings in a row of calls;
+        when a whole budget passed without a collision or wall hit,
+        :meth:`_never_again` looks for a proof that none will ever come, and
+        the budget doubles if it finds none (so the check costs O(log) calls).
+        When it finds one, ``time`` goes back to the last collision or wall hit
+        (or to where the call started): the crossings after it changed nothing.
+        """
+        backend = self._backend
+        done, start = 0, self.time
+        budget = 64 + 16 * len(self.discs)
+        while True:
+            crossings = backend.counts()["cell_crossings"]
+            k = self._chunked(INF, None if limit is None else limit - done, log, budget)
+            done += k
+            if done == limit or backend.counts()["cell_crossings"] - crossings < budget:
+                return done  # the event limit, or nothing left in the queue
+            if k == 0:
+                if self._never_again():
+                    last = backend.last_event() if done else None  # done > 0: there is one
+                    self._rewind(start if last is None else last[0])
+                    return done
+                budget *= 2
+
+    def _rewind(self, time: float) -> None:
+        """Back to ``time``, after a proof that no disc will ever hit anything again (:meth:`_never_again`).
+
+        The discs have crossed cells since ``time``, so the clock alone cannot go back: each disc's cell would
+        be one it reaches only later, and after a change of course (``set_velocities``) the predictions would
+        scan the wrong neighbours and miss collisions. The backend starts afresh at ``time`` from the discs as
+        they are then (what ``EventDriven(sim.snapshot(), box)`` would do), keeping the counters, the virial,
+        the periodic images and the last event. O(N), once per proof.
+        """
+        old = self._backend
+        last = old.last_event()
+        old.time = time
+        now = self.snapshot()
+        scene = Scene(now, self.box, self.scene.segments, self.scene.pass_through, check=False)
+        self._restructure(np.arange(len(now)), None, scene, last)
+
+    #: A run raises :class:`~discsim.errors.JammedError` after ``jam_events + jam_events_per_disc * N``
+    #: physical events in a row at one instant: far more than a finite cascade of simultaneous collisions
+    #: (``N (N - 1) / 2`` at most for a touching row), while wedged discs collide there for ever.
+    jam_events: int = 10_000
+    jam_events_per_disc: int = 100
+    _jam_mark: tuple[float, int] | None = None  # (time, physical events) when the clock was last seen there
+
+    def _chunked(self, until: float, limit: int | None, log, crossings: int | None = None) -> int:
+        """``backend.advance(until, limit, log, crossings)`` in chunks, watching the clock between them.
+
+        The same result as one call (chunks change nothing in the dynamics), for every backend. Each chunk
+        holds at most the jam threshold of physical events; when that many pass, over any number of calls
+        (a driver's chunks, ``step()`` after ``step()``), with the clock standing still, the discs are jammed.
+
+        Raises:
+            JammedError: naming the jammed discs; the engine is consistent at its last whole event.
+        """
+        backend = self._backend
+        chunk = self.jam_events + self.jam_events_per_disc * len(self.discs)
+        done, left = 0, crossings
+        while True:
+            ask = chunk if limit is None else min(chunk, limit - done)
+            if self._jam_mark is None or self._jam_mark[0] != backend.time:
+                self._jam_mark = (backend.time, self._units())
+            crossed = backend.counts()["cell_crossings"] if crossings is not None else 0
+            k = backend.advance(until, ask, log, left)
+            done += k
+            units = self._units()
+            if backend.time != self._jam_mark[0]:
+                self._jam_mark = (backend.time, units)
+            elif units - self._jam_mark[1] >= chunk:
+                raise JammedError(self._jam_message(units - self._jam_mark[1]))
+            if k < ask or done == limit:
+                return done  # the time or event limit, an empty queue, or the crossings asked for
+            if left is not None:
+                left -= backend.counts()["cell_crossings"] - crossed
+                if left <= 0:
+                    return done
+
+    def _jammed_discs(self) -> np.ndarray:
+        """The discs of the last event and every disc touching them, transitively (sorted, caller's numbering).
+
+        Touching: centres within the contact distance plus 1e-9 of it, minimum image, collision filter obeyed.
+        """
+        last = self._backend.last_event()
+        if last is None:
+            return np.zeros(0, dtype=np.int64)
+        seeds = [d for d in last[2:] if d >= 0]
+        n = len(self.discs)
+        radii = self.discs.radii
+        i, j, d = neighbour_pairs(self.positions, 2.0 * float(radii.max()), self.box)
+        touch = np.hypot(d[:, 0], d[:, 1]) <= (radii[i] + radii[j]) * (1.0 + 1e-9)
+        if self.scene.filtering:
+            touch &= ~self.scene.passes(i, j)
+        i, j = i[touch], j[touch]
+        jammed = np.zeros(n, dtype=bool)
+        jammed[seeds] = True
+        while True:  # grow the touching cluster around the last event's discs
+            grown = jammed.copy()
+            grown[j[jammed[i]]] = True
+            grown[i[jammed[j]]] = True
+            if grown.sum() == jammed.sum():
+                return np.flatnonzero(jammed)
+            jammed = grown
+
+    def _jam_message(self, events: int) -> str:
+        discs = self._jammed_discs().tolist()
+        named = ", ".join(map(str, discs[:20])) + (f", ... ({len(discs)} discs)" if len(discs) > 20 else "")
+        return (
+            f"discs {named} are jammed at time {self.time!r}: wedged against each other or a wall, they made "
+            f"{events} collisions and wall hits without the clock moving; give them room (a gap) or velocities "
+            "that part them"
+        )
+
+    def _never_again(self) -> bool:
+        """True if, from now on, no pair of discs can ever meet and no disc hits a wall or segment.
+
+        Only periodic boxes (a moving disc always reaches a wall). A pair can
+        never meet when its relative velocity is exactly zero, when its groups
+        pass through each other, or when it moves relative to itself only along
+        x (or only along y) and its minimum-image gap across that motion exceeds
+        the contact distance. Any other pair might meet some day, and the answer is False.
+        """
+        box, scene = self.box, self.scene
+        if not box.periodic or len(self.discs) < 2:
+            return box.periodic or not self.velocities.any()
+        pos, vel, radii = self.positions, self.velocities, self.discs.radii
+        # Discs that drift alike never meet: only pairs of different velocities need a look, so N discs
+        # drifting alike cost O(N log N), not O(N^2).
+        label = np.unique(vel, axis=0, return_inverse=True)[1].reshape(-1)
+        groups = [np.flatnonzero(label == g) for g in range(int(label.max()) + 1)]
+        tol = 1e-12 * box.size.max()
+        for g, a in enumerate(groups[:-1]):
+            b = np.concatenate(groups[g + 1 :])
+            dv = vel[b] - vel[a[0]]  # the same for every disc of group a
+            still = (dv == 0.0).all(axis=1)  # rows of -0.0 and 0.0 land in two groups
+            block = max(1, (1 << 22) // len(b))  # bounds memory: block x |b| pairs at a time
+            for start in range(0, len(a), block):
+                rows = a[start : start + block]
+                gap = box.minimum_image(pos[b][None, :, :] - pos[rows][:, None, :])
+                reach = (radii[rows][:, None] + radii[b][None, :]) * (1.0 + 1e-9) + tol
+                along_y = (dv[:, 0] == 0.0) & (np.abs(gap[..., 0]) > reach)  # x gap fixed for good
+                along_x = (dv[:, 1] == 0.0) & (np.abs(gap[..., 1]) > reach)
+                never = still | along_y | along_x
+                if scene.filtering:
+                    never |= scene.blocked[scene.group[rows][:, None], scene.group[b][None, :]]
+                if not never.all():
+                    return False
+        return True

@@ -8,24 +8,17 @@ cells a box meets, each once, sorted, as the Python frame's set does.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from discsim._compiled import compile_from_source
+from discsim.engines.fixed_step import parts
 from discsim.engines.fixed_step.numba.candidates import S_EXT, S_STAMP, leaf
 from discsim.engines.fixed_step.numba.kernels import _heapsort, jit
 
-
-@jit
-def _table_shape(n, cell, width, height):
-    """``(nx, ny)`` of ``CellTable``: cells of side ``cell`` or more, at most ``max(4 N, 65536)``."""
-    nx = max(1, int(width // cell))
-    ny = max(1, int(height // cell))
-    cap = max(4 * n, 1 << 16)
-    if nx * ny > cap:
-        scale = math.sqrt(nx * ny / cap)
-        nx, ny = max(1, int(nx / scale)), max(1, int(ny / scale))
-    return nx, ny
+# The table's shape and the cells a box meets: CellTable's own functions, compiled from their source.
+_compiled = compile_from_source((parts.table_shape, parts.cell_span), leaf)
+_table_shape = _compiled[parts.table_shape]
+_span = _compiled[parts.cell_span]
 
 
 @jit
@@ -47,17 +40,6 @@ def _table(pos, nx, ny, lx, ly):
         order[fill[cell[i]]] = i
         fill[cell[i]] += 1
     return start, order
-
-
-@leaf
-def _span(lo, hi, size, count, periodic):
-    """``CellTable._span``: ``(first, last, wrap)``, the cells ``first..last`` (``% count`` when ``wrap``)."""
-    first, last = math.floor(lo / size), math.floor(hi / size)
-    if periodic:
-        if last - first + 1 >= count:
-            return 0, count - 1, False
-        return first, last, True
-    return min(max(first, 0), count - 1), min(max(last, 0), count - 1), False
 
 
 @leaf

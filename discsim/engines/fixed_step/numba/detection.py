@@ -3,9 +3,9 @@
 The order of the floating-point operations is that of :mod:`discsim.engines.fixed_step.sub_frame`. Python's
 ``x ** 2`` is the C library's ``pow``, which is not ``x * x`` to the last bit (about one value in a thousand):
 ``bisect`` squares with ``math.pow`` and an exponent that comes from the caller (``two``), so that LLVM cannot
-turn it into a product. Python's ``round`` of the inline minimum image keeps a ``-0.0`` that
-:meth:`~discsim.model.Box.minimum_image` turns into ``+0.0``: :func:`_round_image` does what the inline
-formula does.
+turn it into a product. The minimum image of a pair found by the broad phase is
+:meth:`~discsim.model.Box.minimum_image`'s (``_image``); that of two paths, the Python frame's scalar
+:func:`~discsim.model.minimum_image_1d` (``_nearest_image``: they differ in the sign of a zero).
 """
 
 from __future__ import annotations
@@ -31,22 +31,17 @@ from discsim.engines.fixed_step.numba.kernels import (
     _heapsort,
     _image,
     _near_pairs,
+    _nearest_image,
     _segment_distance,
     jit,
 )
+from discsim.physics.compiled import advance
 from discsim.physics.compiled import pair_time_of_impact as _time_of_impact
 from discsim.physics.compiled import segment_time_of_impact as _segment_time_of_impact
+from discsim.physics.compiled import wall_time as _wall_time
 
 
 # --- scalar kernels ----------------------------------------------------------------------------------------
-@leaf
-def _round_image(d, size):
-    """``d - size * round(d / size)`` as the Python frame writes it inline (``-0.0`` stays ``-0.0``)."""
-    if abs(d) <= 0.5 * size:
-        return d
-    return d - size * np.rint(d / size)
-
-
 @leaf
 def _cross(ux, uy, vx, vy):
     return ux * vy - uy * vx
@@ -76,15 +71,16 @@ def _path_segment_distance(px, py, ex, ey, ax, ay, bx, by):
 def _overlapping(kind, s, p, periodic, width, height, two):
     """The interference test at time ``s`` of the candidate in ``p``."""
     if kind == COLLISION:
-        dx = p[5] + p[7] * (s - p[9]) - (p[0] + p[2] * (s - p[4]))
-        dy = p[6] + p[8] * (s - p[9]) - (p[1] + p[3] * (s - p[4]))
+        xa, ya, _, _ = advance(p[0], p[1], p[2], p[3], s - p[4])
+        xb, yb, _, _ = advance(p[5], p[6], p[7], p[8], s - p[9])
+        dx, dy = xb - xa, yb - ya
         if periodic:
-            dx, dy = _round_image(dx, width), _round_image(dy, height)
+            dx, dy = _nearest_image(dx, width), _nearest_image(dy, height)
         return dx * dx + dy * dy < p[10]
     if kind == WALL:
         position = p[0] + p[1] * (s - p[2])
         return position > p[3] if p[5] > 0.0 else position < p[4]
-    px, py = p[0] + p[2] * (s - p[4]), p[1] + p[3] * (s - p[4])
+    px, py, _, _ = advance(p[0], p[1], p[2], p[3], s - p[4])
     qx, qy = _closest_point(px, py, p[6], p[7], p[8], p[9])
     return math.pow(px - qx, two) + math.pow(py - qy, two) < p[5]
 
@@ -293,15 +289,10 @@ def _detect_swept(keys, all_pairs, mid, start, t0, t, paths, scene, heap, found,
             length = width if axis == 0 else height
             for a in range(n):
                 x, v, r = start[a, axis], vel[a, axis], radii[a]
-                if v > 0.0:
-                    wt = (length - r - x) / v
-                elif v < 0.0:
-                    wt = (r - x) / v
-                else:
-                    wt = INF
+                wt = _wall_time(x, v, r, length)
                 if wt <= span:
                     wall = 2 * axis + (1 if v > 0.0 else 0)
-                    heap, found = _push_growing(heap, found, st, version, t0 + (0.0 if 0.0 > wt else wt), WALL, a, wall)
+                    heap, found = _push_growing(heap, found, st, version, t0 + wt, WALL, a, wall)
     if len(segments):
         counts[C_SEGMENT_TESTS] += n * len(segments)
         for a in range(n):

@@ -68,18 +68,19 @@ from discsim.engines.fixed_step.numba.detection import (
     _detect_bisect,
     _detect_swept,
     _overlapping,
-    _round_image,
 )
 from discsim.engines.fixed_step.numba.kernels import (
     _closest_point,
     _collide,
     _image,
     _impulse_virial,
+    _nearest_image,
     _reflect,
     _wrap,
     cpython_hypot,
     jit,
 )
+from discsim.physics.compiled import advance
 from discsim.physics.compiled import pair_time_of_impact as _time_of_impact
 from discsim.physics.compiled import segment_time_of_impact as _segment_time_of_impact
 from discsim.physics.compiled import wall_time as _wall_time
@@ -126,7 +127,8 @@ def _log(ev_n, ev_f, st, frame, tc, a, b, xa, ya, vxa, vya, xb, yb, vxb, vyb):
 def _at(paths, a, s):
     """Centre of disc ``a`` at time ``s`` on its current path (not wrapped)."""
     ref_pos, vel, ref_t, _ = paths
-    return ref_pos[a, 0] + vel[a, 0] * (s - ref_t[a]), ref_pos[a, 1] + vel[a, 1] * (s - ref_t[a])
+    x, y, _, _ = advance(ref_pos[a, 0], ref_pos[a, 1], vel[a, 0], vel[a, 1], s - ref_t[a])
+    return x, y
 
 
 @leaf
@@ -144,7 +146,7 @@ def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, count
         xb, yb = _at(paths, b, tc)
         dx, dy = xb - xa, yb - ya
         if periodic:
-            dx, dy = _round_image(dx, width), _round_image(dy, height)
+            dx, dy = _nearest_image(dx, width), _nearest_image(dy, height)
         vxa, vya, vxb, vyb = vel[a, 0], vel[a, 1], vel[b, 0], vel[b, 1]
         if (vxb - vxa) * dx + (vyb - vya) * dy >= 0.0:  # not approaching: nothing to do
             return False
@@ -208,10 +210,10 @@ def _recheck(code, a, now, t, kind, other, near, count, p, tol, paths, scene, tw
         counts[C_PAIR_TESTS] += count
         for q in range(count):
             m = near[q]
-            dx = ref_pos[m, 0] + vel[m, 0] * (now - ref_t[m]) - x
-            dy = ref_pos[m, 1] + vel[m, 1] * (now - ref_t[m]) - y
+            xm, ym, _, _ = advance(ref_pos[m, 0], ref_pos[m, 1], vel[m, 0], vel[m, 1], now - ref_t[m])
+            dx, dy = xm - x, ym - y
             if periodic:
-                dx, dy = _round_image(dx, width), _round_image(dy, height)
+                dx, dy = _nearest_image(dx, width), _nearest_image(dy, height)
             dvx, dvy, sigma = vel[m, 0] - vx, vel[m, 1] - vy, r + radii[m]
             tc = INF
             if code == BISECT:
@@ -323,7 +325,7 @@ def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam):
         # The frame's first candidates, and where the cell table sees the discs.
         if code == BISECT:
             for i in range(n):  # Paths.flown, then Box.wrap
-                x, y = ref_pos[i, 0] + vel[i, 0] * (t - ref_t[i]), ref_pos[i, 1] + vel[i, 1] * (t - ref_t[i])
+                x, y, _, _ = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i])
                 pos[i, 0], pos[i, 1] = (_wrap(x, width), _wrap(y, height)) if periodic else (x, y)
             table_reach = 0.0
             keys = _candidates(pos, diameter, all_pairs, scene)
@@ -413,7 +415,7 @@ def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam):
                 )  # fmt: skip
         # The frame's end: the discs' places, and the deepest overlap of the pairs that were candidates.
         for i in range(n):
-            x, y = ref_pos[i, 0] + vel[i, 0] * (t - ref_t[i]), ref_pos[i, 1] + vel[i, 1] * (t - ref_t[i])
+            x, y, _, _ = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i])
             pos[i, 0], pos[i, 1] = (_wrap(x, width), _wrap(y, height)) if periodic else (x, y)
         for k in range(st[S_FOUND]):
             i, j = found[k, 0], found[k, 1]

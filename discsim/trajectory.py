@@ -11,6 +11,7 @@ import numpy as np
 
 from discsim.errors import TimeError
 from discsim.events import added_discs
+from discsim.model import image_steps
 from discsim.physics.dynamics import advance
 
 __all__ = ["check_times", "log_start", "positions_from_log", "reconstruct"]
@@ -125,7 +126,7 @@ def _image_shifts(disc, t_rec, state, starts, size) -> np.ndarray:
     """
     x, y, _, _ = advance(state[:-1, 0], state[:-1, 1], state[:-1, 2], state[:-1, 3], t_rec[1:] - t_rec[:-1])
     flown = np.column_stack([x, y])
-    jump = np.nan_to_num(np.round((flown - state[1:, :2]) / size) * size)  # NaN: not there yet, or gone
+    jump = np.nan_to_num(image_steps(flown, state[1:, :2], size) * size)  # NaN: not there yet, or gone
     jump[np.isin(np.arange(1, len(state)), starts)] = 0.0  # the first record of the next disc
     shifts = np.zeros_like(state[:, :2])
     shifts[1:] = np.cumsum(jump, axis=0)

@@ -11,6 +11,7 @@ import numpy as np
 
 from discsim.engines.fixed_step.parts import impulse_virial, wrap
 from discsim.events import EventLog
+from discsim.model import image_step, image_steps
 from discsim.scene import Scene
 
 __all__ = ["Paths", "Shapes", "Tally", "impulse_virial"]
@@ -90,7 +91,7 @@ class Paths:
         """
         if flown is not None and self.box.periodic:
             size = self.box.size
-            self.images[rows] += np.round((flown - positions) / size).astype(np.int64)
+            self.images[rows] += image_steps(flown, positions, size).astype(np.int64)
         self.ref_positions[rows] = positions
         self.ref_times[rows] = t
 
@@ -103,7 +104,7 @@ class Paths:
         if box.periodic:
             wx, wy = wrap(x, box.width), wrap(y, box.height)
             if wx != x or wy != y:  # it left the box since its last change of course
-                self.images[disc] += np.round((np.array([x, y]) - (wx, wy)) / box.size).astype(np.int64)
+                self.images[disc] += (image_step(x, wx, box.width), image_step(y, wy, box.height))
             x, y = wx, wy
         self.ref_positions[disc] = (x, y)
         self.ref_times[disc] = t

@@ -26,7 +26,7 @@ import numpy as np
 from discsim._compiled import compile_from_source
 from discsim._numba import numba
 from discsim.engines.fixed_step import parts
-from discsim.model import minimum_image_1d
+from discsim.model import image_step, minimum_image_1d
 from discsim.physics.compiled import advance
 from discsim.physics.compiled import closest_point_on_segment as _closest_point
 from discsim.physics.compiled import collide as _collide
@@ -43,11 +43,12 @@ else:
     # tested (or that cannot vanish), as the Python frame does.
     jit = _nb.njit(cache=True, error_model="numpy")
 
-# The frame's own parts (discsim.engines.fixed_step.parts), compiled from their source: the Python frames call
-# the same functions.
+# The frame's own parts (discsim.engines.fixed_step.parts, and the image count of discsim.model), compiled from
+# their source: the Python frames call the same functions.
 _parts = compile_from_source(
-    (minimum_image_1d, parts.wrap, parts.nearest_image, parts.box_image, parts.impulse_virial), jit
+    (minimum_image_1d, image_step, parts.wrap, parts.nearest_image, parts.box_image, parts.impulse_virial), jit
 )
+_image_step = _parts[image_step]
 _wrap = _parts[parts.wrap]
 _nearest_image = _parts[parts.nearest_image]  # the rule as the Python frames' scalar loops compute it
 _image = _parts[parts.box_image]  # as Box.minimum_image computes it on arrays (a zero as +0.0)
@@ -595,8 +596,8 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
             if not changed[i]:
                 continue
             if periodic:
-                images[i, 0] += np.int64(np.rint((flown[i, 0] - pos[i, 0]) / width))
-                images[i, 1] += np.int64(np.rint((flown[i, 1] - pos[i, 1]) / height))
+                images[i, 0] += _image_step(flown[i, 0], pos[i, 0], width)
+                images[i, 1] += _image_step(flown[i, 1], pos[i, 1], height)
             ref_pos[i, 0], ref_pos[i, 1] = pos[i, 0], pos[i, 1]
             ref_t[i] = t
         if periodic:

@@ -73,6 +73,7 @@ from discsim.engines.fixed_step.numba.kernels import (
     _closest_point,
     _collide,
     _image,
+    _image_step,
     _impulse_virial,
     _nearest_image,
     _reflect,
@@ -103,8 +104,8 @@ def _turn(a, tc, x, y, vx, vy, paths, version, periodic, width, height):
     if periodic:
         wx, wy = _wrap(x, width), _wrap(y, height)
         if wx != x or wy != y:  # it left the box since its last change of course
-            images[a, 0] += np.int64(np.rint((x - wx) / width))
-            images[a, 1] += np.int64(np.rint((y - wy) / height))
+            images[a, 0] += _image_step(x, wx, width)
+            images[a, 1] += _image_step(y, wy, height)
         x, y = wx, wy
     ref_pos[a, 0], ref_pos[a, 1] = x, y
     ref_t[a] = tc

@@ -141,7 +141,8 @@ class CellGrid:
         shared: dict[tuple, tuple] = {}
         for cx in range(nx):
             for cy in range(ny):
-                cells, offs = [], []
+                cells: list[int] = []
+                offs: list[tuple[float, float]] = []
                 for dx in (-1, 0, 1):
                     for dy in (-1, 0, 1):
                         ox, oy, sx, sy = cx + dx, cy + dy, 0.0, 0.0
@@ -157,8 +158,8 @@ class CellGrid:
                         offs.append((sx, sy))
                 if with_neighbours:
                     neighbours.append(tuple(cells))
-                offs = tuple(offs)
-                shifts.append(shared.setdefault(offs, offs))
+                key = tuple(offs)
+                shifts.append(shared.setdefault(key, key))
         return (neighbours if with_neighbours else None), shifts
 
 

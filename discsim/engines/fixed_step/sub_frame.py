@@ -34,7 +34,7 @@ from abc import abstractmethod
 import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
-from discsim.engines.fixed_step.broad_phase import BroadPhase
+from discsim.engines.fixed_step.broad_phase import AllDiscs, BroadPhase, CellTable
 from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
 from discsim.engines.fixed_step.parts import impulse_virial
 from discsim.errors import InvalidArgumentError, JammedError
@@ -121,9 +121,9 @@ class SubFrame:
         self.done: dict[tuple[int, int, int], float] = {}  # when each contact was last responded to
         self.events: list[Event] = []
         self.found: set = set()  # pairs that were candidates, for the overlap at the frame's end
-        self.table_pos: np.ndarray | None = None  # where the broad phase saw the discs
+        self.table_pos: np.ndarray = np.zeros((0, 2))  # where the broad phase saw the discs (set by detect)
         self.table_reach = 0.0  # how far (length) a disc unchanged in course can be from there
-        self._table = None
+        self._table: CellTable | AllDiscs | None = None
         self.log = tally.log
         box = self.shapes.box
         self.periodic = box.periodic
@@ -227,13 +227,13 @@ class SubFrame:
         near = self._cell_table().near(lo, hi)
         near.discard(a)
         near.discard(partner)
-        group = self.shapes.group
-        if group is not None:
-            passes = self.shapes.blocked[group[a]]
+        group, blocked = self.shapes.group, self.shapes.blocked
+        if group is not None and blocked is not None:  # both or neither
+            passes = blocked[group[a]]
             return sorted(m for m in near if not passes[group[m]])
         return sorted(near)
 
-    def _cell_table(self):
+    def _cell_table(self) -> CellTable | AllDiscs:
         if self._table is None:
             self._table = self.policy.broad.table(self.table_pos, self.shapes.diameter + self.table_reach)
         return self._table
@@ -552,7 +552,8 @@ class Swept(SubFramePolicy):
             ends = shapes.seg_ends
             for a, k in zip(*np.nonzero(dist <= radii[:, None])):
                 a, k = int(a), int(k)
-                tau = segment_time_of_impact(*start[a].tolist(), *vel[a].tolist(), shapes.radius[a], *ends[k])
+                (x, y), (vx, vy) = start[a].tolist(), vel[a].tolist()
+                tau = segment_time_of_impact(x, y, vx, vy, shapes.radius[a], *ends[k])
                 if tau <= span:
                     frame.push(t0 + tau, SEGMENT, a, k)
 

@@ -14,6 +14,8 @@ import math
 
 import numpy as np
 
+from discsim._compiled import compile_from_source
+from discsim.cells import cells_along, grid_counts
 from discsim.engines.fixed_step.numba.candidates import (
     C_BISECTION_TESTS,
     C_PAIR_TESTS,
@@ -39,6 +41,9 @@ from discsim.physics.compiled import advance
 from discsim.physics.compiled import pair_time_of_impact as _time_of_impact
 from discsim.physics.compiled import segment_time_of_impact as _segment_time_of_impact
 from discsim.physics.compiled import wall_time as _wall_time
+
+# The one cell-sizing rule (discsim.cells.grid_shape's), compiled from its source.
+_grid_counts = compile_from_source((cells_along, grid_counts), jit)[grid_counts]
 
 
 # --- scalar kernels ----------------------------------------------------------------------------------------
@@ -137,20 +142,6 @@ def _bisect_segment(a, k, s0, t1, tol, p, paths, radii, segments, width, height,
 
 # --- the frame's first candidates (Bisect.detect, Swept.detect) --------------------------------------------
 @jit
-def _grid_shape(periodic, width, height, min_cell, max_cells):
-    """:func:`discsim.cells.grid_shape` without ``what`` (a periodic box under 3 cells a side gets one)."""
-    nx = max(1, math.floor(width / min_cell * (1 + 1e-12)))
-    ny = max(1, math.floor(height / min_cell * (1 + 1e-12)))
-    if periodic and min(nx, ny) < 3:
-        return 1, 1
-    if nx * ny > max_cells:
-        scale = math.sqrt(nx * ny / max_cells)
-        floor_n = 3 if periodic else 1
-        nx, ny = max(floor_n, int(nx / scale)), max(floor_n, int(ny / scale))
-    return nx, ny
-
-
-@jit
 def _candidates(pos, reach, all_pairs, scene):
     """``SubFrame.pairs`` of the ``"grid"`` broad phase: the pairs at ``pos`` as keys ``i * N + j``
     (``i < j``), sorted: :func:`discsim.cells.neighbour_pairs` with cells of side ``reach``, less the pairs
@@ -162,7 +153,7 @@ def _candidates(pos, reach, all_pairs, scene):
         return np.zeros(0, dtype=np.int64)
     if all_pairs:  # the detection walks every pair itself (_next_pair)
         return np.zeros(0, dtype=np.int64)
-    nx, ny = _grid_shape(periodic, width, height, reach, max(4 * n, 1 << 16))
+    nx, ny = _grid_counts(width, height, periodic, reach, max(4 * n, 1 << 16))
     cx, cy, start, order, rank = _cells(pos, nx, ny, nx / width, ny / height)
     size = 8 * n + 64
     while True:

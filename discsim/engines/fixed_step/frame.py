@@ -28,7 +28,7 @@ import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BroadPhase
-from discsim.engines.fixed_step.parts import impulse_virial
+from discsim.engines.fixed_step.parts import impulse_virial, push_off_segment, separate_pair
 from discsim.events import Event
 from discsim.kernels import closest_point_on_segment, reflect_off_segment, resolve_collision
 from discsim.model import minimum_image_1d
@@ -351,26 +351,10 @@ class Separate(FramePolicy):
         return np.where(low, r, np.where(high, size - r, pos))
 
     def off_segment(self, x, y, qx, qy, nx, ny, r):
-        dist = math.hypot(nx, ny)
-        if dist < r:
-            return qx + nx / dist * r, qy + ny / dist * r
-        return x, y
+        return push_off_segment(x, y, qx, qy, nx, ny, r, math.hypot(nx, ny))
 
     def contact(self, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, before_i, before_j):
-        dist = math.hypot(dx, dy)
-        depth = sigma - dist
-        if depth > 0.0 and dist > 0.0:
-            if mi == math.inf:
-                wi, wj = 0.0, 1.0
-            elif mj == math.inf:
-                wi, wj = 1.0, 0.0
-            else:
-                wi, wj = mj / (mi + mj), mi / (mi + mj)
-            ux, uy = dx / dist, dy / dist
-            xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
-            xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
-            dx, dy = ux * (dist + depth), uy * (dist + depth)
-        return xi, yi, xj, yj, dx, dy
+        return separate_pair(xi, yi, xj, yj, dx, dy, mi, mj, sigma, math.hypot(dx, dy))
 
 
 #: The frame policies by name.

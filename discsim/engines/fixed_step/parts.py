@@ -9,6 +9,9 @@ very source (``discsim._compiled.compile_from_source``), so the two cannot drift
   :func:`~discsim.model.minimum_image_1d` (the rule ``d - L round(d / L)``) as a scalar loop computes it, and
   as :meth:`~discsim.model.Box.minimum_image` computes it on arrays (the two differ in the sign of a zero);
 - :func:`impulse_virial`: the term one pair response adds to the collision virial;
+- :func:`separate_pair` and :func:`push_off_segment`: where the ``"separate"`` policy leaves two overlapping
+  discs, or a disc cutting a segment (the caller passes the distance: Python's ``math.hypot`` is not the C
+  library's, so the compiled frames pass CPython's, ``numba.kernels.cpython_hypot``);
 - :func:`table_shape` and :func:`cell_span`: the cells of the sub-frame policies' cell table
   (:class:`~discsim.engines.fixed_step.broad_phase.CellTable`) and the cells a box meets.
 
@@ -22,7 +25,16 @@ import math
 
 from discsim.model import minimum_image_1d
 
-__all__ = ["box_image", "cell_span", "impulse_virial", "nearest_image", "table_shape", "wrap"]
+__all__ = [
+    "box_image",
+    "cell_span",
+    "impulse_virial",
+    "nearest_image",
+    "push_off_segment",
+    "separate_pair",
+    "table_shape",
+    "wrap",
+]
 
 INF = math.inf
 WHOLE = 4503599627370496.0  # 2 ** 52: every float this large or larger is a whole number
@@ -100,6 +112,52 @@ def impulse_virial(
     if mi != INF:
         return -mi * ((uxi - vxi) * sx + (uyi - vyi) * sy)
     return mj * ((uxj - vxj) * sx + (uyj - vyj) * sy)
+
+
+def separate_pair(
+    xi: float, yi: float, xj: float, yj: float, dx: float, dy: float,
+    mi: float, mj: float, sigma: float, dist: float,
+) -> tuple[float, float, float, float, float, float]:  # fmt: skip
+    """Discs ``i`` at ``(xi, yi)`` and ``j`` at ``(xj, yj)``, ``(dx, dy)`` apart (``j - i``, minimum image) and
+    ``dist = hypot(dx, dy)`` apart, pushed apart along the line of centres until they touch (``sigma``), each
+    in inverse proportion to its mass (an infinite mass stays).
+
+    Returns:
+        ``(xi, yi, xj, yj, dx, dy)``: the new centres and the line of centres at contact (unchanged when the
+        discs do not overlap or coincide).
+
+    Example:
+        >>> separate_pair(0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, 1.0, 2.0, 1.0)
+        (-0.5, 0.0, 1.5, 0.0, 2.0, 0.0)
+    """
+    depth = sigma - dist
+    if depth > 0.0 and dist > 0.0:
+        if mi == INF:
+            wi, wj = 0.0, 1.0
+        elif mj == INF:
+            wi, wj = 1.0, 0.0
+        else:
+            wi, wj = mj / (mi + mj), mi / (mi + mj)
+        ux, uy = dx / dist, dy / dist
+        xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
+        xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
+        dx, dy = ux * (dist + depth), uy * (dist + depth)
+    return xi, yi, xj, yj, dx, dy
+
+
+def push_off_segment(
+    x: float, y: float, qx: float, qy: float, nx: float, ny: float, r: float, dist: float
+) -> tuple[float, float]:
+    """A disc of radius ``r`` at ``(x, y)``, ``dist = hypot(nx, ny)`` from its nearest point ``(qx, qy)`` of a
+    segment along the normal ``(nx, ny)``, pushed out along the normal until it touches.
+
+    Example:
+        >>> push_off_segment(0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 1.0, 0.5)
+        (0.0, 1.0)
+    """
+    if dist < r:
+        return qx + nx / dist * r, qy + ny / dist * r
+    return x, y
 
 
 def table_shape(n: int, cell: float, width: float, height: float) -> tuple[int, int]:

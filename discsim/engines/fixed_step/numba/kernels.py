@@ -46,8 +46,20 @@ else:
 # The frame's own parts (discsim.engines.fixed_step.parts, and the image count of discsim.model), compiled from
 # their source: the Python frames call the same functions.
 _parts = compile_from_source(
-    (minimum_image_1d, image_step, parts.wrap, parts.nearest_image, parts.box_image, parts.impulse_virial), jit
+    (
+        minimum_image_1d,
+        image_step,
+        parts.wrap,
+        parts.nearest_image,
+        parts.box_image,
+        parts.impulse_virial,
+        parts.separate_pair,
+        parts.push_off_segment,
+    ),
+    jit,
 )
+_separate_pair = _parts[parts.separate_pair]
+_push_off_segment = _parts[parts.push_off_segment]
 _image_step = _parts[image_step]
 _wrap = _parts[parts.wrap]
 _nearest_image = _parts[parts.nearest_image]  # the rule as the Python frames' scalar loops compute it
@@ -222,9 +234,7 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r):
         if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
             continue
         if policy == SEPARATE:
-            dist = cpython_hypot(nx, ny)
-            if dist < r:
-                x, y = qx + nx / dist * r, qy + ny / dist * r
+            x, y = _push_off_segment(x, y, qx, qy, nx, ny, r, cpython_hypot(nx, ny))
         vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by)
         responded = True
     return x, y, vx, vy, responded
@@ -480,19 +490,7 @@ def _contact(policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j
         if dvx * px + dvy * py < 0.0:  # else keep the frame's line, which is approaching
             dx, dy = px, py
     elif policy == SEPARATE:
-        dist = cpython_hypot(dx, dy)
-        depth = sigma - dist
-        if depth > 0.0 and dist > 0.0:
-            if mi == INF:
-                wi, wj = 0.0, 1.0
-            elif mj == INF:
-                wi, wj = 1.0, 0.0
-            else:
-                wi, wj = mj / (mi + mj), mi / (mi + mj)
-            ux, uy = dx / dist, dy / dist
-            xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
-            xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
-            dx, dy = ux * (dist + depth), uy * (dist + depth)
+        xi, yi, xj, yj, dx, dy = _separate_pair(xi, yi, xj, yj, dx, dy, mi, mj, sigma, cpython_hypot(dx, dy))
     return xi, yi, xj, yj, dx, dy
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from discsim.errors import BoxTooSmallError, InvalidArgumentError
 from discsim.model import Box
 
-__all__ = ["CellGrid", "grid_shape", "neighbour_pairs"]
+__all__ = ["CellGrid", "cells_along", "grid_counts", "grid_shape", "neighbour_pairs"]
 
 
 def grid_shape(box: Box, min_cell: float, max_cells: int | None = None, what: str | None = None) -> tuple[int, int]:
@@ -40,20 +40,41 @@ def grid_shape(box: Box, min_cell: float, max_cells: int | None = None, what: st
         >>> grid_shape(Box(10.0, 4.0), 1.0), grid_shape(Box(10.0, 4.0), 1.0, max_cells=10)
         ((10, 4), (5, 2))
     """
-    nx = max(1, math.floor(box.width / min_cell * (1 + 1e-12)))
-    ny = max(1, math.floor(box.height / min_cell * (1 + 1e-12)))
-    if box.periodic and min(nx, ny) < 3:
-        if what is None:
-            return 1, 1
-        axis, length = ("x", box.width) if nx < 3 else ("y", box.height)
+    nx, ny = grid_counts(box.width, box.height, box.periodic, min_cell, 0 if max_cells is None else max_cells)
+    if what is not None and box.periodic and nx * ny == 1:  # a periodic box gets one cell only when too small
+        axis, length = ("x", box.width) if cells_along(box.width, min_cell) < 3 else ("y", box.height)
         msg = (
             f"periodic box {axis}-extent {length:g} is too small for its cell grid: it needs at "
             f"least 3 cells of side >= {min_cell:g} ({what}), i.e. >= {3 * min_cell:g}"
         )
         raise BoxTooSmallError(msg)
-    if max_cells is not None and nx * ny > max_cells:
+    return nx, ny
+
+
+def cells_along(length: float, min_cell: float) -> int:
+    """Cells of side ``min_cell`` or more that fit along ``length`` (at least 1), with a relative slack of 1e-12.
+
+    Example:
+        >>> cells_along(10.0, 1.0), cells_along(0.3, 0.1), cells_along(0.5, 1.0)
+        (10, 3, 1)
+    """
+    return max(1, math.floor(length / min_cell * (1 + 1e-12)))
+
+
+def grid_counts(width: float, height: float, periodic: bool, min_cell: float, max_cells: int) -> tuple[int, int]:
+    """:func:`grid_shape` on plain numbers, for the loops (numba compiles this very function into the compiled
+    fixed-step frames): ``max_cells`` 0 for no bound; a periodic box under 3 cells a side gets one cell.
+
+    Example:
+        >>> grid_counts(10.0, 4.0, False, 1.0, 10), grid_counts(10.0, 2.0, True, 1.0, 0)
+        ((5, 2), (1, 1))
+    """
+    nx, ny = cells_along(width, min_cell), cells_along(height, min_cell)
+    if periodic and min(nx, ny) < 3:
+        return 1, 1
+    if 0 < max_cells < nx * ny:
         scale = math.sqrt(nx * ny / max_cells)
-        floor_n = 3 if box.periodic else 1
+        floor_n = 3 if periodic else 1
         nx = max(floor_n, int(nx / scale))
         ny = max(floor_n, int(ny / scale))
     return nx, ny
@@ -141,7 +162,8 @@ class CellGrid:
         shared: dict[tuple, tuple] = {}
         for cx in range(nx):
             for cy in range(ny):
-                cells, offs = [], []
+                cells: list[int] = []
+                offs: list[tuple[float, float]] = []
                 for dx in (-1, 0, 1):
                     for dy in (-1, 0, 1):
                         ox, oy, sx, sy = cx + dx, cy + dy, 0.0, 0.0
@@ -157,8 +179,8 @@ class CellGrid:
                         offs.append((sx, sy))
                 if with_neighbours:
                     neighbours.append(tuple(cells))
-                offs = tuple(offs)
-                shifts.append(shared.setdefault(offs, offs))
+                key = tuple(offs)
+                shifts.append(shared.setdefault(key, key))
         return (neighbours if with_neighbours else None), shifts
 
 

@@ -139,7 +139,11 @@ class EventLog:
     #: :meth:`remove` take ids. Change it only after :meth:`flush`.
     ids: np.ndarray | None = None
 
-    def __init__(self):
+    def __init__(self) -> None:
+        self._reset()
+
+    def _reset(self) -> None:
+        """No records."""
         self._pending: list[tuple] = []  # rows not yet in the arrays, oldest first
         self._blocks: list[np.ndarray] = []  # full (or joined) arrays of rows, oldest first; never written again
         self._stored = 0  # rows in _blocks
@@ -287,7 +291,7 @@ class EventLog:
 
     def clear(self) -> None:
         """Drop every record (arrays handed out by :meth:`to_array` keep theirs); :attr:`ids` stays."""
-        self.__init__()
+        self._reset()
 
     def __len__(self) -> int:
         return self._stored + self._fill - self._start + len(self._pending)

@@ -22,6 +22,9 @@ __all__ = [
     "Box",
     "Discs",
     "Segment",
+    "frame_count",
+    "image_step",
+    "image_steps",
     "kinetic_energy",
     "minimum_image_1d",
     "momentum",
@@ -345,6 +348,41 @@ def minimum_image_1d(d: float, length: float) -> float:
         (-1.0, 4.0)
     """
     return d - length * round(d / length)
+
+
+def image_step(flown: float, wrapped: float, length: float) -> int:
+    """Whole box lengths between a coordinate ``flown`` along a path and ``wrapped``, the same point mapped
+    into a periodic box ``length`` long: what the point's image count gains (rounds halves to even).
+
+    One float each (numba compiles this very function into the compiled frames); :func:`image_steps` on arrays.
+
+    Example:
+        >>> image_step(12.5, 2.5, 10.0), image_step(-0.5, 9.5, 10.0)
+        (1, -1)
+    """
+    return round((flown - wrapped) / length)
+
+
+def image_steps(flown: np.ndarray, wrapped: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """:func:`image_step` on arrays: ``(..., 2)`` float whole box lengths (``size``, ``(2,)``) between points
+    ``flown`` and ``wrapped`` (NaN where either is NaN).
+
+    Example:
+        >>> image_steps(np.array([[12.5, -0.5]]), np.array([[2.5, 9.5]]), np.array([10.0, 10.0])).tolist()
+        [[1.0, -1.0]]
+    """
+    return np.round((flown - wrapped) / size)
+
+
+def frame_count(start: float, end: float, dt: float) -> int:
+    """The number of whole frame intervals ``dt`` from ``start`` to ``end`` (times), allowing for the roundoff
+    of ``k * dt``: a relative slack of 1e-12 and an absolute one of 1e-9 frames.
+
+    Example:
+        >>> frame_count(0.0, 0.3, 0.1), frame_count(1.0, 1.25, 0.1)
+        (3, 2)
+    """
+    return math.floor((end - start) / dt * (1 + 1e-12) + 1e-9)
 
 
 class Segment:

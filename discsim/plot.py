@@ -29,7 +29,7 @@ from matplotlib.patches import Circle, Rectangle
 
 from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION
-from discsim.model import Discs
+from discsim.model import Discs, frame_count
 
 __all__ = ["animate", "close", "plot_case", "plot_cases", "plot_state", "plot_trajectories", "save_figure"]
 
@@ -212,7 +212,7 @@ def _frame_times(truth, approx, max_frames: int) -> np.ndarray:
     end = min(float(truth.time), float(approx.time))
     dt = max(float(getattr(e, "dt", 0.0) or 0.0) for e in (truth, approx))
     if dt > 0:
-        count = math.floor((end - start) / dt * (1 + 1e-12) + 1e-9)
+        count = frame_count(start, end, dt)
         times = np.minimum(start + dt * np.arange(count + 1), end)
     else:
         times = np.linspace(start, end, 11)
@@ -457,7 +457,7 @@ def _animation_times(sims, max_frames: int) -> tuple[np.ndarray, float]:
     end = min(float(s.time) for s in sims)
     dt = max(float(getattr(s, "dt", 0.0) or 0.0) for s in sims)
     if dt > 0:
-        count = math.floor((end - start) / dt * (1 + 1e-12) + 1e-9)
+        count = frame_count(start, end, dt)
         sub = max(1, min(math.ceil(_ANIMATION_FRAMES / max(1, count)), max(1, (max_frames - 1) // max(1, count))))
         times = np.minimum(start + dt * (np.arange(count * sub + 1) / sub), end)
     else:

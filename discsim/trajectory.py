@@ -11,6 +11,7 @@ import numpy as np
 
 from discsim.errors import TimeError
 from discsim.events import added_discs
+from discsim.model import image_steps
 from discsim.physics.dynamics import advance
 
 __all__ = ["check_times", "log_start", "positions_from_log", "reconstruct"]
@@ -79,25 +80,25 @@ def reconstruct(
     # One state record per disc per change: initial state, then each event's i and j.
     # Each record also keeps the index of its event (-1 for the initial state), so
     # that a disc changing twice at one time (a chain of contacts) keeps the later state.
-    disc = [np.arange(n)]
-    t_rec = [np.full(n, float(time0))]
-    seq = [np.full(n, -1)]
-    state = [np.hstack([positions0, velocities0])]
+    discs: list[np.ndarray] = [np.arange(n)]
+    t_recs: list[np.ndarray] = [np.full(n, float(time0))]
+    seqs: list[np.ndarray] = [np.full(n, -1)]
+    states: list[np.ndarray] = [np.hstack([positions0, velocities0])]
     if len(events):
-        disc.append(events["i"])
-        t_rec.append(events["time"])
-        seq.append(np.arange(len(events)))
-        state.append(np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]))
+        discs.append(events["i"])
+        t_recs.append(events["time"])
+        seqs.append(np.arange(len(events)))
+        states.append(np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]))
         pair = np.flatnonzero(events["j"] >= 0)
         ev = events[pair]
-        disc.append(ev["j"])
-        t_rec.append(ev["time"])
-        seq.append(pair)
-        state.append(np.column_stack([ev["xj"], ev["yj"], ev["vxj"], ev["vyj"]]))
-    disc = np.concatenate(disc)
-    t_rec = np.concatenate(t_rec)
-    seq = np.concatenate(seq)
-    state = np.vstack(state)
+        discs.append(ev["j"])
+        t_recs.append(ev["time"])
+        seqs.append(pair)
+        states.append(np.column_stack([ev["xj"], ev["yj"], ev["vxj"], ev["vyj"]]))
+    disc = np.concatenate(discs)
+    t_rec = np.concatenate(t_recs)
+    seq = np.concatenate(seqs)
+    state = np.vstack(states)
     order = np.lexsort((seq, t_rec, disc))  # by disc, then time, then log order
     disc, t_rec, state = disc[order], t_rec[order], state[order]
     starts = np.searchsorted(disc, np.arange(n + 1))
@@ -125,7 +126,7 @@ def _image_shifts(disc, t_rec, state, starts, size) -> np.ndarray:
     """
     x, y, _, _ = advance(state[:-1, 0], state[:-1, 1], state[:-1, 2], state[:-1, 3], t_rec[1:] - t_rec[:-1])
     flown = np.column_stack([x, y])
-    jump = np.nan_to_num(np.round((flown - state[1:, :2]) / size) * size)  # NaN: not there yet, or gone
+    jump = np.nan_to_num(image_steps(flown, state[1:, :2], size) * size)  # NaN: not there yet, or gone
     jump[np.isin(np.arange(1, len(state)), starts)] = 0.0  # the first record of the next disc
     shifts = np.zeros_like(state[:, :2])
     shifts[1:] = np.cumsum(jump, axis=0)

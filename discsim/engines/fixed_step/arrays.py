@@ -7,11 +7,11 @@ and change these objects only; the engine owns them, exports them as a
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from discsim.engines.fixed_step.parts import impulse_virial, wrap
 from discsim.events import EventLog
+from discsim.model import image_step, image_steps
 from discsim.scene import Scene
 
 __all__ = ["Paths", "Shapes", "Tally", "impulse_virial"]
@@ -91,7 +91,7 @@ class Paths:
         """
         if flown is not None and self.box.periodic:
             size = self.box.size
-            self.images[rows] += np.round((flown - positions) / size).astype(np.int64)
+            self.images[rows] += image_steps(flown, positions, size).astype(np.int64)
         self.ref_positions[rows] = positions
         self.ref_times[rows] = t
 
@@ -100,12 +100,11 @@ class Paths:
 
         Returns the new reference position, wrapped into a periodic box.
         """
-        if self.box.periodic:
-            flown = np.array([x, y])
-            here = self.box.wrap(flown)
-            wx, wy = here.tolist()
+        box = self.box
+        if box.periodic:
+            wx, wy = wrap(x, box.width), wrap(y, box.height)
             if wx != x or wy != y:  # it left the box since its last change of course
-                self.images[disc] += np.round((flown - here) / self.box.size).astype(np.int64)
+                self.images[disc] += (image_step(x, wx, box.width), image_step(y, wy, box.height))
             x, y = wx, wy
         self.ref_positions[disc] = (x, y)
         self.ref_times[disc] = t
@@ -136,20 +135,3 @@ class Tally:
         self.max_overlap = float(max_overlap)
         self.virial = float(virial)
         self.log: EventLog | None = None
-
-
-def impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj) -> float:
-    """``dp_i . (r_i - r_j)`` of one pair response: the term it adds to :attr:`Tally.virial` (energy).
-
-    ``(sx, sy)``: the separation ``r_j - r_i`` where the impulse is applied; ``v`` the velocities
-    before, ``u`` after; ``mi``, ``mj`` the masses. ``dp_i = m_i (u_i - v_i)``, or ``-m_j (u_j - v_j)``
-    when disc ``i`` is an obstacle (infinite mass). The event-driven loop adds the same term.
-    The compiled frame (:mod:`discsim.engines.fixed_step.numba.kernels`) repeats these operations.
-
-    Example:
-        >>> impulse_virial(2.0, 0.0, 1.0, 0.0, -1.0, 0.0, -1.0, 0.0, 1.0, 0.0, 1.0, 1.0)  # head on, touching
-        4.0
-    """
-    if mi != math.inf:
-        return -mi * ((uxi - vxi) * sx + (uyi - vyi) * sy)
-    return mj * ((uxj - vxj) * sx + (uyj - vyj) * sy)

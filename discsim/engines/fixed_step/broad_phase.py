@@ -10,13 +10,13 @@ policies' queries: the pairs near each other at some positions, and the discs ne
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 
 import numpy as np
 
 from discsim.cells import neighbour_pairs
 from discsim.engines.fixed_step.arrays import Shapes
+from discsim.engines.fixed_step.parts import cell_span, table_shape
 from discsim.model import Box
 
 __all__ = ["BROAD_PHASE_CLASSES", "AllPairs", "BroadPhase", "CellTable", "VerletGrid"]
@@ -154,13 +154,7 @@ class CellTable:
     """
 
     def __init__(self, pos: np.ndarray, cell: float, box: Box):
-        n = len(pos)
-        nx = max(1, int(box.width // cell))
-        ny = max(1, int(box.height // cell))
-        cap = max(4 * n, 1 << 16)
-        if nx * ny > cap:
-            scale = math.sqrt(nx * ny / cap)
-            nx, ny = max(1, int(nx / scale)), max(1, int(ny / scale))
+        nx, ny = table_shape(len(pos), cell, box.width, box.height)
         self.nx, self.ny = nx, ny
         self.lx, self.ly = box.width / nx, box.height / ny
         self.periodic = box.periodic
@@ -175,12 +169,10 @@ class CellTable:
         self.start = start.tolist()
 
     def _span(self, lo: float, hi: float, size: float, count: int) -> list[int]:
-        first, last = math.floor(lo / size), math.floor(hi / size)
-        if self.periodic:
-            if last - first + 1 >= count:
-                return list(range(count))
+        first, last, wraps = cell_span(lo, hi, size, count, self.periodic)
+        if wraps:
             return [c % count for c in range(first, last + 1)]
-        return list(range(min(max(first, 0), count - 1), min(max(last, 0), count - 1) + 1))
+        return list(range(first, last + 1))
 
     def _cells(self, lo: tuple[float, float], hi: tuple[float, float]) -> list[int]:
         ny = self.ny

@@ -45,7 +45,7 @@ from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisec
 from discsim.engines.record import collision_virials
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
-from discsim.model import Box, Discs, _readonly
+from discsim.model import Box, Discs, _readonly, frame_count
 from discsim.scene import Scene
 
 __all__ = ["BACKENDS", "BROAD_PHASES", "COMPILED_POLICIES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
@@ -391,7 +391,7 @@ class FixedStep(Engine):
         """
         if until == math.inf:
             return None
-        last = math.floor((until - self.start_time) / self.dt * (1 + 1e-12) + 1e-9)
+        last = frame_count(self.start_time, until, self.dt)
         return max(0, last - self.frames)
 
     def _units(self) -> int:

@@ -26,10 +26,12 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally, impulse_virial
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BroadPhase
+from discsim.engines.fixed_step.parts import impulse_virial, push_off_segment, separate_pair
 from discsim.events import Event
 from discsim.kernels import closest_point_on_segment, reflect_off_segment, resolve_collision
+from discsim.model import minimum_image_1d
 
 __all__ = [
     "FRAME_POLICY_CLASSES",
@@ -254,9 +256,8 @@ class FramePolicy(Policy):
             xi, yi = at[i]
             xj, yj = at[j]
             dx, dy = xj - xi, yj - yi
-            if periodic:  # the minimum image, inline: this loop runs per pair
-                dx -= width * round(dx / width)
-                dy -= height * round(dy / height)
+            if periodic:
+                dx, dy = minimum_image_1d(dx, width), minimum_image_1d(dy, height)
             vxi, vyi = speed[i]
             vxj, vyj = speed[j]
             dvx, dvy = vxj - vxi, vyj - vyi
@@ -269,8 +270,7 @@ class FramePolicy(Policy):
             uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
             sx, sy = xj - xi, yj - yi  # where the impulse is applied (moved there by "revert" or "separate")
             if periodic:
-                sx -= width * round(sx / width)
-                sy -= height * round(sy / height)
+                sx, sy = minimum_image_1d(sx, width), minimum_image_1d(sy, height)
             virial += impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj)
             at[i], at[j] = (xi, yi), (xj, yj)
             speed[i], speed[j] = (uxi, uyi), (uxj, uyj)
@@ -336,8 +336,7 @@ class Revert(FramePolicy):
         px, py = xj - xi, yj - yi
         box = self.shapes.box
         if box.periodic:
-            px -= box.width * round(px / box.width)
-            py -= box.height * round(py / box.height)
+            px, py = minimum_image_1d(px, box.width), minimum_image_1d(py, box.height)
         if dvx * px + dvy * py < 0.0:  # else keep the frame's line, which is approaching
             dx, dy = px, py
         return xi, yi, xj, yj, dx, dy
@@ -352,26 +351,10 @@ class Separate(FramePolicy):
         return np.where(low, r, np.where(high, size - r, pos))
 
     def off_segment(self, x, y, qx, qy, nx, ny, r):
-        dist = math.hypot(nx, ny)
-        if dist < r:
-            return qx + nx / dist * r, qy + ny / dist * r
-        return x, y
+        return push_off_segment(x, y, qx, qy, nx, ny, r, math.hypot(nx, ny))
 
     def contact(self, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, before_i, before_j):
-        dist = math.hypot(dx, dy)
-        depth = sigma - dist
-        if depth > 0.0 and dist > 0.0:
-            if mi == math.inf:
-                wi, wj = 0.0, 1.0
-            elif mj == math.inf:
-                wi, wj = 1.0, 0.0
-            else:
-                wi, wj = mj / (mi + mj), mi / (mi + mj)
-            ux, uy = dx / dist, dy / dist
-            xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
-            xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
-            dx, dy = ux * (dist + depth), uy * (dist + depth)
-        return xi, yi, xj, yj, dx, dy
+        return separate_pair(xi, yi, xj, yj, dx, dy, mi, mj, sigma, math.hypot(dx, dy))
 
 
 #: The frame policies by name.

@@ -33,9 +33,10 @@ from abc import abstractmethod
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally, impulse_virial
-from discsim.engines.fixed_step.broad_phase import BroadPhase
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
+from discsim.engines.fixed_step.broad_phase import AllDiscs, BroadPhase, CellTable
 from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
+from discsim.engines.fixed_step.parts import impulse_virial
 from discsim.errors import InvalidArgumentError, JammedError
 from discsim.events import Event, EventKind
 from discsim.kernels import (
@@ -47,6 +48,8 @@ from discsim.kernels import (
     time_of_impact_bisect,
     wall_time,
 )
+from discsim.model import minimum_image_1d
+from discsim.physics.dynamics import advance
 
 __all__ = ["SUB_FRAME_POLICY_CLASSES", "Bisect", "SubFrame", "SubFramePolicy", "Swept"]
 
@@ -118,9 +121,9 @@ class SubFrame:
         self.done: dict[tuple[int, int, int], float] = {}  # when each contact was last responded to
         self.events: list[Event] = []
         self.found: set = set()  # pairs that were candidates, for the overlap at the frame's end
-        self.table_pos: np.ndarray | None = None  # where the broad phase saw the discs
+        self.table_pos: np.ndarray = np.zeros((0, 2))  # where the broad phase saw the discs (set by detect)
         self.table_reach = 0.0  # how far (length) a disc unchanged in course can be from there
-        self._table = None
+        self._table: CellTable | AllDiscs | None = None
         self.log = tally.log
         box = self.shapes.box
         self.periodic = box.periodic
@@ -210,7 +213,8 @@ class SubFrame:
     def at(self, a: int, s: float) -> tuple[float, float]:
         """Centre of disc ``a`` at time ``s`` on its current path (not wrapped)."""
         x, y, vx, vy, tr = self.path(a)
-        return x + vx * (s - tr), y + vy * (s - tr)
+        x, y, _, _ = advance(x, y, vx, vy, s - tr)
+        return x, y
 
     def _near(self, a: int, lo: tuple[float, float], hi: tuple[float, float], partner: int) -> list[int]:
         """Discs that may touch disc ``a`` in the rest of the frame, sorted; ``a`` and ``partner`` left out.
@@ -223,13 +227,13 @@ class SubFrame:
         near = self._cell_table().near(lo, hi)
         near.discard(a)
         near.discard(partner)
-        group = self.shapes.group
-        if group is not None:
-            passes = self.shapes.blocked[group[a]]
+        group, blocked = self.shapes.group, self.shapes.blocked
+        if group is not None and blocked is not None:  # both or neither
+            passes = blocked[group[a]]
             return sorted(m for m in near if not passes[group[m]])
         return sorted(near)
 
-    def _cell_table(self):
+    def _cell_table(self) -> CellTable | AllDiscs:
         if self._table is None:
             self._table = self.policy.broad.table(self.table_pos, self.shapes.diameter + self.table_reach)
         return self._table
@@ -249,9 +253,8 @@ class SubFrame:
         xa, ya = self.at(a, tc)
         xb, yb = self.at(b, tc)
         dx, dy = xb - xa, yb - ya
-        if self.periodic:  # the minimum image, inline: this runs per response
-            dx -= self.width * round(dx / self.width)
-            dy -= self.height * round(dy / self.height)
+        if self.periodic:
+            dx, dy = minimum_image_1d(dx, self.width), minimum_image_1d(dy, self.height)
         vxa, vya = paths.velocities[a].tolist()
         vxb, vyb = paths.velocities[b].tolist()
         if (vxb - vxa) * dx + (vyb - vya) * dy >= 0.0:  # not approaching: nothing to do
@@ -339,6 +342,7 @@ class SubFrame:
                 shapes.radii[nb].tolist(),
             )
             for m, (px, py), (ux, uy), tm, rm in neighbours:
+                # Free flight and the minimum image (minimum_image_1d) inline: this loop runs per neighbour.
                 dx, dy = px + ux * (now - tm) - x, py + uy * (now - tm) - y
                 if periodic:
                     dx -= width * round(dx / width)
@@ -442,7 +446,7 @@ class Bisect(SubFramePolicy):
         sigma2 = (self.shapes.radius[a] + self.shapes.radius[b]) ** 2
         periodic, width, height = frame.periodic, frame.width, frame.height
 
-        def overlapping(s: float) -> bool:
+        def overlapping(s: float) -> bool:  # free flight and minimum_image_1d inline: the bisection's test
             dx = xb + ub * (s - tb) - (xa + ua * (s - ta))
             dy = yb + wb * (s - tb) - (ya + wa * (s - ta))
             if periodic:
@@ -530,10 +534,10 @@ class Swept(SubFramePolicy):
             closest = d0 + s[:, None] * sweep
             contact = radii[i] + radii[j]
             hit = np.sum(closest * closest, axis=1) <= contact * contact  # touching at the frame counts
-            if hit.any():
-                toi = _times_of_impact(d0[hit, 0], d0[hit, 1], dv[hit, 0], dv[hit, 1], contact[hit])
-                due = toi <= span
-                for a, b, tau in zip(i[hit][due].tolist(), j[hit][due].tolist(), toi[due].tolist()):
+            hits = zip(i[hit].tolist(), j[hit].tolist(), d0[hit].tolist(), dv[hit].tolist(), contact[hit].tolist())
+            for a, b, (dx, dy), (dvx, dvy), sigma in hits:
+                tau = time_of_impact(dx, dy, dvx, dvy, sigma)
+                if tau <= span:
                     frame.push(t0 + tau, COLLISION, a, b)
         if not frame.periodic:
             for axis, length in ((0, frame.width), (1, frame.height)):
@@ -548,7 +552,8 @@ class Swept(SubFramePolicy):
             ends = shapes.seg_ends
             for a, k in zip(*np.nonzero(dist <= radii[:, None])):
                 a, k = int(a), int(k)
-                tau = segment_time_of_impact(*start[a].tolist(), *vel[a].tolist(), shapes.radius[a], *ends[k])
+                (x, y), (vx, vy) = start[a].tolist(), vel[a].tolist()
+                tau = segment_time_of_impact(x, y, vx, vy, shapes.radius[a], *ends[k])
                 if tau <= span:
                     frame.push(t0 + tau, SEGMENT, a, k)
 
@@ -587,15 +592,3 @@ def _segment_segment_distance(p0: np.ndarray, p1: np.ndarray, a: np.ndarray, b: 
     e, f = b - a, p1 - p0
     crossing = (cross(e, p0 - a) * cross(e, p1 - a) < 0.0) & (cross(f, a - p0) * cross(f, b - p0) < 0.0)
     return np.where(crossing, 0.0, dist)
-
-
-def _times_of_impact(dx, dy, dvx, dvy, sigma) -> np.ndarray:
-    """:func:`~discsim.kernels.time_of_impact` over arrays (the same floats, element by element)."""
-    b = dx * dvx + dy * dvy
-    c = dx * dx + dy * dy - sigma * sigma
-    a = dvx * dvx + dvy * dvy
-    disc = b * b - a * c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = c / (-b + np.sqrt(np.maximum(disc, 0.0)))
-    toi = np.where(c <= 0.0, 0.0, root)
-    return np.where((b < 0.0) & ((c <= 0.0) | (disc > 0.0)), toi, np.inf)

@@ -23,7 +23,11 @@ import math
 
 import numpy as np
 
+from discsim._compiled import compile_from_source
 from discsim._numba import numba
+from discsim.engines.fixed_step import parts
+from discsim.model import image_step, minimum_image_1d
+from discsim.physics.compiled import advance
 from discsim.physics.compiled import closest_point_on_segment as _closest_point
 from discsim.physics.compiled import collide as _collide
 from discsim.physics.compiled import reflect_off_segment as _reflect
@@ -38,6 +42,29 @@ else:
     # error_model="numpy": no zero check on every division; the frame divides only by numbers it has
     # tested (or that cannot vanish), as the Python frame does.
     jit = _nb.njit(cache=True, error_model="numpy")
+
+# The frame's own parts (discsim.engines.fixed_step.parts, and the image count of discsim.model), compiled from
+# their source: the Python frames call the same functions.
+_parts = compile_from_source(
+    (
+        minimum_image_1d,
+        image_step,
+        parts.wrap,
+        parts.nearest_image,
+        parts.box_image,
+        parts.impulse_virial,
+        parts.separate_pair,
+        parts.push_off_segment,
+    ),
+    jit,
+)
+_separate_pair = _parts[parts.separate_pair]
+_push_off_segment = _parts[parts.push_off_segment]
+_image_step = _parts[image_step]
+_wrap = _parts[parts.wrap]
+_nearest_image = _parts[parts.nearest_image]  # the rule as the Python frames' scalar loops compute it
+_image = _parts[parts.box_image]  # as Box.minimum_image computes it on arrays (a zero as +0.0)
+_impulse_virial = _parts[parts.impulse_virial]
 
 #: The compiled policies by name: the ``policy`` argument of :func:`frames`.
 POLICY_CODES = {"resolve": 0, "revert": 1, "separate": 2}
@@ -111,38 +138,6 @@ def cpython_hypot(x, y):
 
 
 @jit
-def _wrap(v, size):
-    """:meth:`discsim.model.Box.wrap` of one coordinate (periodic box): ``v % size``, the size itself to 0.
-
-    The usual cases are done without the remainder, with the floats it gives (the exact ``fmod`` of a
-    number within one box length of the box is itself, or itself less the length), 4x faster.
-    """
-    if 0.0 < v < size:
-        return v
-    if v == 0.0:
-        return 0.0  # -0.0 % size is +0.0
-    if -size <= v < 0.0:
-        m = v + size
-        return 0.0 if m >= size else m
-    if size <= v < 2.0 * size:
-        return v - size  # exact
-    m = v % size
-    return 0.0 if m >= size else m
-
-
-@jit
-def _image(d, size):
-    """:meth:`discsim.model.Box.minimum_image` of one coordinate: ``d - size * rint(d / size)``.
-
-    Within half a box length ``rint`` gives a zero and ``d`` comes back as it is (a zero as +0.0, as the
-    formula gives it), without the division, 4x faster.
-    """
-    if abs(d) <= 0.5 * size:
-        return d if d != 0.0 else 0.0
-    return d - size * np.rint(d / size)
-
-
-@jit
 def _segment_distance(px, py, ax, ay, bx, by):
     """:func:`discsim.engines.fixed_step.frame.point_segment_distance` of one point and one segment."""
     ex, ey = bx - ax, by - ay
@@ -151,14 +146,6 @@ def _segment_distance(px, py, ax, ay, bx, by):
     u = (wx * ex + wy * ey) / ee if ee > 0.0 else 0.0
     u = min(max(u, 0.0), 1.0)
     return math.hypot(wx - u * ex, wy - u * ey)  # numpy's hypot: the C library's, as numba's
-
-
-@jit
-def _impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj):
-    """:func:`discsim.engines.fixed_step.arrays.impulse_virial`."""
-    if mi != INF:
-        return -mi * ((uxi - vxi) * sx + (uyi - vyi) * sy)
-    return mj * ((uxj - vxj) * sx + (uyj - vyj) * sy)
 
 
 # --- the event buffer ------------------------------------------------------------------------------------
@@ -247,9 +234,7 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r):
         if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
             continue
         if policy == SEPARATE:
-            dist = cpython_hypot(nx, ny)
-            if dist < r:
-                x, y = qx + nx / dist * r, qy + ny / dist * r
+            x, y = _push_off_segment(x, y, qx, qy, nx, ny, r, cpython_hypot(nx, ny))
         vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by)
         responded = True
     return x, y, vx, vy, responded
@@ -501,23 +486,11 @@ def _contact(policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j
         xj, yj = prev[j, 0], prev[j, 1]
         px, py = xj - xi, yj - yi
         if periodic:
-            px, py = _image(px, width), _image(py, height)
+            px, py = _nearest_image(px, width), _nearest_image(py, height)
         if dvx * px + dvy * py < 0.0:  # else keep the frame's line, which is approaching
             dx, dy = px, py
     elif policy == SEPARATE:
-        dist = cpython_hypot(dx, dy)
-        depth = sigma - dist
-        if depth > 0.0 and dist > 0.0:
-            if mi == INF:
-                wi, wj = 0.0, 1.0
-            elif mj == INF:
-                wi, wj = 1.0, 0.0
-            else:
-                wi, wj = mj / (mi + mj), mi / (mi + mj)
-            ux, uy = dx / dist, dy / dist
-            xi, yi = xi - wi * depth * ux, yi - wi * depth * uy
-            xj, yj = xj + wj * depth * ux, yj + wj * depth * uy
-            dx, dy = ux * (dist + depth), uy * (dist + depth)
+        xi, yi, xj, yj, dx, dy = _separate_pair(xi, yi, xj, yj, dx, dy, mi, mj, sigma, cpython_hypot(dx, dy))
     return xi, yi, xj, yj, dx, dy
 
 
@@ -537,7 +510,7 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
         xi, yi, xj, yj = pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1]
         dx, dy = xj - xi, yj - yi
         if periodic:
-            dx, dy = _image(dx, width), _image(dy, height)
+            dx, dy = _nearest_image(dx, width), _nearest_image(dy, height)
         vxi, vyi, vxj, vyj = vel[i, 0], vel[i, 1], vel[j, 0], vel[j, 1]
         dvx, dvy = vxj - vxi, vyj - vyi
         if dvx * dx + dvy * dy >= 0.0:  # separating already (an earlier response this frame)
@@ -550,13 +523,14 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
         uxi, uyi, uxj, uyj = _collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
         sx, sy = xj - xi, yj - yi  # where the impulse is applied
         if periodic:
-            sx, sy = _image(sx, width), _image(sy, height)
+            sx, sy = _nearest_image(sx, width), _nearest_image(sy, height)
         virial += _impulse_virial(sx, sy, vxi, vyi, uxi, uyi, vxj, vyj, uxj, uyj, mi, mj)
         if periodic:  # no walls: ref_pos, ref_t and vel still hold the path the disc had at the last frame
             for d in (i, j):
                 if not changed[d]:
-                    for axis in range(2):
-                        flown[d, axis] = ref_pos[d, axis] + vel[d, axis] * (t - ref_t[d])
+                    flown[d, 0], flown[d, 1], _, _ = advance(
+                        ref_pos[d, 0], ref_pos[d, 1], vel[d, 0], vel[d, 1], t - ref_t[d]
+                    )
         pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1] = xi, yi, xj, yj
         vel[i, 0], vel[i, 1], vel[j, 0], vel[j, 1] = uxi, uyi, uxj, uyj
         changed[i] = changed[j] = True
@@ -586,8 +560,7 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
     all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
     n = len(ref_pos)
     for i in range(n):  # Paths.flown, then Box.wrap
-        dt = t - ref_t[i]
-        x, y = ref_pos[i, 0] + vel[i, 0] * dt, ref_pos[i, 1] + vel[i, 1] * dt
+        x, y, _, _ = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i])
         if periodic:
             x, y = _wrap(x, width), _wrap(y, height)
         pos[i, 0], pos[i, 1] = x, y
@@ -621,8 +594,8 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
             if not changed[i]:
                 continue
             if periodic:
-                images[i, 0] += np.int64(np.rint((flown[i, 0] - pos[i, 0]) / width))
-                images[i, 1] += np.int64(np.rint((flown[i, 1] - pos[i, 1]) / height))
+                images[i, 0] += _image_step(flown[i, 0], pos[i, 0], width)
+                images[i, 1] += _image_step(flown[i, 1], pos[i, 1], height)
             ref_pos[i, 0], ref_pos[i, 1] = pos[i, 0], pos[i, 1]
             ref_t[i] = t
         if periodic:

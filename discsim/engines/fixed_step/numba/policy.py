@@ -100,8 +100,8 @@ class CompiledFrame(Policy):
         scene, box = shapes.scene, shapes.box
         n = len(scene)
         self._scene = _scene_arrays(shapes)
-        self._grid = isinstance(broad, VerletGrid)
-        if self._grid:
+        self._verlet = broad if isinstance(broad, VerletGrid) else None  # the "grid" broad phase keeps the list
+        if isinstance(broad, VerletGrid):
             # The numbers VerletGrid and neighbour_pairs compute, computed as they do.
             reach = shapes.diameter + broad.skin
             nx, ny = grid_shape(box, reach, max(4 * n, 1 << 16))
@@ -128,11 +128,11 @@ class CompiledFrame(Policy):
             With ``events``, the :class:`~discsim.events.Event` of each response, frame by frame;
             else None.
         """
-        broad = self.broad
-        if self._grid and broad.list_positions is not None:
-            listed = (False, broad.list_positions, broad.list_i, broad.list_j, *self._list_args)
+        verlet = self._verlet
+        if verlet is not None and verlet.list_positions is not None:
+            listed = (False, verlet.list_positions, verlet.list_i, verlet.list_j, *self._list_args)
         else:
-            listed = (not self._grid, self._no_list, self._no_pairs, self._no_pairs, *self._list_args)
+            listed = (verlet is None, self._no_list, self._no_pairs, self._no_pairs, *self._list_args)
         counts = self._counts
         counts[:] = 0
         state = (paths.ref_positions, paths.velocities, paths.ref_times, paths.images, paths.frame_positions)
@@ -144,8 +144,8 @@ class CompiledFrame(Policy):
         steps = counts.tolist()
         for name, step in zip(_COUNTERS, steps):
             tally.counts[name] += step
-        if steps[kernels.C_LIST_BUILDS]:
-            broad.list_positions, broad.list_i, broad.list_j = list_pos, list_i, list_j
+        if verlet is not None and steps[kernels.C_LIST_BUILDS]:
+            verlet.list_positions, verlet.list_i, verlet.list_j = list_pos, list_i, list_j
         if not len(ev_n):
             return [] if events else None
         at = times[ev_n[:, 0]]

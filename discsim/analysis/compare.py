@@ -20,7 +20,7 @@ import numpy as np
 from discsim.cells import neighbour_pairs
 from discsim.errors import InvalidArgumentError, WrongTypeError
 from discsim.events import COLLISION, WALL
-from discsim.model import kinetic_energy
+from discsim.model import frame_count, kinetic_energy
 from discsim.trajectory import check_times
 
 __all__ = ["Comparison", "compare"]
@@ -444,7 +444,7 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     if times is None:
         frame = max(dts)
         if frame > 0:
-            count = math.floor((horizon - start) / frame * (1 + 1e-12) + 1e-9)
+            count = frame_count(start, horizon, frame)
             times = np.minimum(start + frame * np.arange(count + 1), horizon)  # k * dt may overshoot by roundoff
         else:
             times = np.linspace(start, horizon, _DEFAULT_SAMPLES)

@@ -38,7 +38,7 @@ from discsim.engines.base import Engine, EngineState, provide, registered_engine
 from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
-from discsim.model import Box, Discs, Segment
+from discsim.model import Box, Discs, Segment, image_steps
 from discsim.scene import Scene
 from discsim.trajectory import reconstruct
 
@@ -326,7 +326,7 @@ def _first_layout(engine: Any, meta: dict, arrays: dict) -> tuple[dict, dict, En
         unwrapped = reconstruct(
             events, arrays["discs.positions"], arrays["discs.velocities"], 0.0, [state.time], box, unwrapped=True
         )[0]
-        state.images = np.round((unwrapped - state.positions_at(state.time)) / box.size).astype(np.int64)
+        state.images = image_steps(unwrapped, state.positions_at(state.time), box.size).astype(np.int64)
     scene = {"segments": settings.get("segments", []), "pass_through": settings.get("pass_through", [])}
     new_settings = {"record": settings["record"], "queue": settings["queue"], "cell_size": cell_size}
     return scene, new_settings, state, events

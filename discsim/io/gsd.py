@@ -26,7 +26,7 @@ import numpy as np
 
 from discsim.analysis.frames import Frames
 from discsim.errors import InvalidArgumentError
-from discsim.model import Box
+from discsim.model import Box, image_steps
 
 __all__ = ["append_frames", "open_gsd", "read_gsd", "require_gsd", "write_gsd"]
 
@@ -63,7 +63,7 @@ def _gsd_frame(frames: Frames, k: int, step: int):
     position[:, :2] = frames.positions[k] - 0.5 * size
     image = np.zeros((n, 3), dtype=np.int32)
     if box.periodic:
-        image[:, :2] = np.round((frames.unwrapped[k] - frames.positions[k]) / size).astype(np.int32)
+        image[:, :2] = image_steps(frames.unwrapped[k], frames.positions[k], size).astype(np.int32)
     velocity = np.zeros((n, 3))
     velocity[:, :2] = frames.velocities[k]
     labels = np.unique(frames.groups)

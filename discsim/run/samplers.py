@@ -14,7 +14,6 @@ engine's own stops are not changed, so a sampled run gives the same events, bit 
 
 from __future__ import annotations
 
-import math
 from typing import cast
 
 import numpy as np
@@ -25,6 +24,7 @@ from discsim.analysis.frames import Frames, states_at
 from discsim.analysis.thermo import VirialBlocks
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, REMOVE
+from discsim.model import frame_count
 from discsim.run.observers import Observer
 
 __all__ = ["GSDWriter", "Sampler"]
@@ -167,7 +167,7 @@ class Sampler(Observer):
     def sample_times(self, until: float) -> np.ndarray:
         """The sample times not yet taken, up to ``until``."""
         origin = cast(float, self._origin)  # None only before the first run, where this raises TypeError as it did
-        last = math.floor((until - origin) / self.dt * (1 + 1e-12) + 1e-9)
+        last = frame_count(origin, until, self.dt)
         if last < self._next:
             return np.zeros(0)
         k = np.arange(self._next, last + 1)

@@ -23,7 +23,7 @@ from discsim.engines.event_driven.state import EventDrivenState
 from discsim.engines.event_driven.stops import RunStops
 from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.events import KIND_NAMES, Event
-from discsim.model import Box, Discs, _readonly
+from discsim.model import Box, Discs, _readonly, image_steps
 from discsim.scene import Scene
 
 __all__ = ["BACKENDS", "EventDriven"]
@@ -217,7 +217,7 @@ class EventDriven(RunStops, Engine):
             state.last_time, state.last_kind, state.last_i, state.last_j = last
         if box.periodic and len(keep):
             unwrapped = old.unwrapped_positions()[keep]
-            state.images[: len(keep)] = np.round((unwrapped - scene.discs.positions[: len(keep)]) / box.size)
+            state.images[: len(keep)] = image_steps(unwrapped, scene.discs.positions[: len(keep)], box.size)
         backend.start(state)
         self.grid, self._backend, self._jam_mark = grid, backend, None
 

@@ -11,7 +11,7 @@ and states) asks these modules, never its own copy:
   pairs, walls, segments and cell crossings.
 
 Every function here is a plain function of floats that uses only arithmetic, comparisons and :mod:`math`, so
-that the same source runs in CPython and, jitted by numba (``discsim._compiled.inline``), inside the compiled
+that the same source runs in CPython and, jitted by numba (``discsim._compiled.jit``), inside the compiled
 loops: written once, compiled from the same source. ``docs/adding-physics.md`` shows how a new law of motion
 or collision law is added.
 """

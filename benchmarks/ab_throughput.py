@@ -401,7 +401,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         row.update(labels)
     columns = [Column(c.key, c.title.replace("coll/s", options["rate"]), c.fmt) for c in COLUMNS]
     print(format_table(rows, columns))
-    stem = "ab_throughput" if args.engine == "event-driven" else "ab_frames"
+    stem = "ab_throughput" if args.engine == "event-driven" else "ab_throughput_frames"
     stem = stem if args.backend == "python" else f"{stem}_{args.backend}"
     csv_path = write_csv(args.out / f"{stem}.csv", rows, CSV_KEYS)
     engine = "EventDriven" if args.engine == "event-driven" else "FixedStep"
@@ -412,7 +412,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def compile_main(args: argparse.Namespace) -> int:
-    """``--compile``: the cold and warm starts table, ``ab_compile.csv``."""
+    """``--compile``: the cold and warm starts table, ``ab_throughput_compile.csv``."""
     labels = {"base_label": tree_label(args.base), "new_label": tree_label(NEW_TREE)}
     print(f"discsim A/B start of the compiled backend; {machine_summary()}")
     print(f"base: {args.base} ({labels['base_label']}); new: {NEW_TREE} ({labels['new_label']})")
@@ -422,7 +422,7 @@ def compile_main(args: argparse.Namespace) -> int:
     for row in rows:
         row.update(labels)
     print(format_table(rows, COMPILE_COLUMNS))
-    path = write_csv(args.out / "ab_compile.csv", rows, [c.key for c in COMPILE_COLUMNS] + list(labels))
+    path = write_csv(args.out / "ab_throughput_compile.csv", rows, [c.key for c in COMPILE_COLUMNS] + list(labels))
     print(f"wrote {path}")
     return 0
 

@@ -68,7 +68,7 @@ def test_instruction_counts_run_and_write_their_table(tmp_path):
 @pytest.mark.skipif(not numba_available(), reason="the compiled backend needs numba")
 def test_compile_mode_times_cold_and_warm_starts(ab_throughput, tmp_path):
     assert ab_throughput.main(["--compile", "--repeats", "1", "--base", str(REPO), "--out", str(tmp_path)]) == 0
-    with open(tmp_path / "ab_compile.csv", newline="") as handle:
+    with open(tmp_path / "ab_throughput_compile.csv", newline="") as handle:
         rows = {row["start"]: row for row in csv.DictReader(handle)}
     assert set(rows) == {"cold", "warm"}
     for side in ("base", "new"):  # a cold start compiles: it takes longer than a warm one, which loads
@@ -87,6 +87,6 @@ def test_quick_run_of_the_compiled_loop(ab_throughput, tmp_path):
 def test_fixed_step_mode_times_frames(ab_throughput, tmp_path):
     argv = ["--quick", "--engine", "fixed-step", "--collisions", "20", "--base", str(REPO), "--out", str(tmp_path)]
     assert ab_throughput.main(argv) == 0
-    with open(tmp_path / "ab_frames.csv", newline="") as handle:
+    with open(tmp_path / "ab_throughput_frames.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == 1 and float(rows[0]["new_median"]) > 0 and rows[0]["backend"] == "python"

@@ -16,7 +16,7 @@ import numpy as np
 
 from discsim.engines.context import RunContext, readonly_ids
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
-from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs
+from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, _real_array
 from discsim.scene import Scene, check_added
 
 __all__ = ["DiscEditing"]
@@ -278,11 +278,11 @@ class DiscEditing:
         if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
             msg = f"indices must be a list of integers in [0, {n}), got {indices!r}"
             raise InvalidArgumentError(msg)
-        idx = idx.astype(np.int64)
-        bad = (idx < 0) | (idx >= n)
-        if bad.any():
-            msg = f"disc index {int(idx[bad][0])} does not exist (this simulation has discs 0 to {n - 1})"
+        outside = [i for i in idx.tolist() if not 0 <= i < n]  # Python ints: 2**64 - 1 stays itself, not -1
+        if outside:
+            msg = f"disc index {outside[0]} does not exist (this simulation has discs 0 to {n - 1})"
             raise InvalidArgumentError(msg)
+        idx = idx.astype(np.int64)
         unique, counts = np.unique(idx, return_counts=True)
         if (counts > 1).any():
             msg = f"disc index {int(unique[counts > 1][0])} is given twice"
@@ -292,11 +292,7 @@ class DiscEditing:
     @staticmethod
     def _rows(name: str, values, idx: np.ndarray) -> np.ndarray:
         """``values`` as a finite ``(K, 2)`` float array (one ``(2,)`` row is repeated for every disc)."""
-        try:
-            rows = np.array(values, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            msg = f"{name} must be numbers of shape ({len(idx)}, 2), got {values!r}"
-            raise InvalidArgumentError(msg) from exc
+        rows = _real_array(name, values, InvalidArgumentError)  # no strings, booleans or complex numbers, as Discs
         if rows.shape == (2,):
             rows = np.tile(rows, (len(idx), 1))
         if rows.shape != (len(idx), 2):

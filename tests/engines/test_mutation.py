@@ -201,3 +201,24 @@ def test_a_run_that_proves_no_collision_leaves_the_cells_where_the_discs_are(eve
     pairs = [np.sort(np.column_stack([log["i"], log["j"]]), axis=1) for log in (ours, theirs)]  # either owns it
     np.testing.assert_array_equal(*pairs)
     np.testing.assert_allclose(ours["time"], theirs["time"], atol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["set_velocities", "apply_impulse", "set_positions"])
+@pytest.mark.parametrize(
+    ("values", "kind"), [([["1.5", "2"]], "strings"), ([[1 + 2j, 0.0]], "complex"), ([[True, False]], "booleans")]
+)
+def test_changes_refuse_what_discs_refuse(method, values, kind):
+    # Issue 30, item 11: strings, complex numbers and booleans were taken (the imaginary part silently dropped),
+    # where Discs() refuses them. Refused now, naming what they are, with nothing changed.
+    sim = ds.EventDriven(*_gas(20))
+    before = sim.state().to_arrays()[1]
+    with pytest.raises(ds.InvalidArgumentError, match=kind):
+        getattr(sim, method)([3], values)
+    after = sim.state().to_arrays()[1]
+    assert all(np.array_equal(before[k], after[k]) for k in before)
+
+
+def test_an_index_past_int64_is_named_as_given():
+    sim = ds.EventDriven(*_gas(20))
+    with pytest.raises(ds.InvalidArgumentError, match="disc index 18446744073709551615 does not exist"):
+        sim.set_velocities([2**64 - 1], [[1.0, 0.0]])

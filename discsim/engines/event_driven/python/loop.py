@@ -29,7 +29,6 @@ from discsim.engines.event_driven.python.layout import (
 )
 from discsim.events import EventLog
 from discsim.physics import laws
-from discsim.physics.laws import reflect
 from discsim.physics.sources import segments
 
 __all__ = ["process_events"]
@@ -53,7 +52,7 @@ def process_events(backend, until: float, limit: int, crossings: int, log: Event
     caller = backend._caller_id  # the caller's numbering, for the log
     counts = backend._counts
     segment_ends = [(*seg.p0.tolist(), *seg.p1.tolist()) for seg in backend.segments]
-    collide, resolve_segment = laws.collide, segments.resolve
+    collide, reflect, resolve_segment = laws.collide, laws.reflect, segments.resolve  # the collision law
     n_coll = n_wall = n_cross = n_stale = 0
     done = 0
     max_queue = backend.max_queue

@@ -28,7 +28,7 @@ from discsim.analysis.theory import (
     virial_z,
 )
 from discsim.analysis.thermo import compressibility_factor, thermo
-from discsim.engines.compress import CompressionReport, compress
+from discsim.engines.compress import Compression, CompressionReport, compress
 from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import POLICIES, FixedStep, FixedStepState
 from discsim.errors import (
@@ -82,6 +82,7 @@ __all__ = [
     "CheckpointError",
     "Checkpointer",
     "Comparison",
+    "Compression",
     "CompressionReport",
     "Contact",
     "Contacts",

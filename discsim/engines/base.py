@@ -179,6 +179,9 @@ class Engine(DiscEditing, EventRecord, ABC):
     progress_chunk: ClassVar[int] = 20_000
     #: Events per chunk of a log streamed by ``run(record_to=...)``; at most this many are held in memory.
     stream_chunk: int = 16_384
+    #: Whether the engine's work ends by itself (a compression reaches its target), so that ``run()`` with no
+    #: limit runs to that end; other engines need ``until`` or a count.
+    runs_to_end: ClassVar[bool] = False
     #: The class of the engine's run state (each engine sets it).
     STATE: ClassVar[type[EngineState]]
 
@@ -237,6 +240,16 @@ class Engine(DiscEditing, EventRecord, ABC):
     def _settle(self, until: float) -> None:
         """Move the clock to ``until`` after a run that stopped on time."""
         self.time = until
+
+    def _progress(self, plan) -> tuple[float, float, bool, str]:
+        """``(position, total, by_time, unit)`` of a progress bar over the run ``plan`` (a ``RunPlan``).
+
+        Over simulated time for a run with ``until`` only, else over the units of work; an engine whose
+        progress is another quantity (a compression's packing) says so here.
+        """
+        if plan.limit is None:
+            return self.time - plan.start_time, plan.until - plan.start_time, True, self.unit
+        return float(self._units() - plan.start_units), float(plan.limit), False, self.unit
 
     # --- the checkpoint's protocol -----------------------------------------------------
     @abstractmethod

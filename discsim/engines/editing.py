@@ -47,6 +47,9 @@ class DiscEditing:
         def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None: ...
         def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene) -> None: ...
 
+    def _check_editable(self, what: str) -> None:
+        """Refuse ``what`` (an edit, or a callback) before anything changes, where the engine cannot take it."""
+
     #: Event kinds a callback can follow with :meth:`on`.
     CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment")
 
@@ -67,6 +70,7 @@ class DiscEditing:
             >>> sim.set_velocities([0], [[1.0, 0.0]]).run(until=4.5).velocities.tolist()
             [[0.0, 0.0], [1.0, 0.0]]
         """
+        self._check_editable("set velocities")
         idx = self._disc_indices(indices)
         self._change(idx, None, self._rows("velocities", velocities, idx))
         return self
@@ -82,6 +86,7 @@ class DiscEditing:
             >>> sim.apply_impulse([0], [0.0, 4.0]).velocities.tolist()
             [[1.0, 2.0]]
         """
+        self._check_editable("apply impulses")
         idx = self._disc_indices(indices)
         impulses = self._rows("impulses", impulses, idx)
         self._refuse_obstacles(idx)
@@ -100,6 +105,7 @@ class DiscEditing:
             OutsideBoxError, OverlapError: naming the disc (and the disc it would overlap).
             InvalidArgumentError: as :meth:`set_velocities`. Nothing changes then.
         """
+        self._check_editable("set positions")
         idx = self._disc_indices(indices)
         self._change(idx, self._rows("positions", positions, idx), None)
         return self
@@ -138,6 +144,7 @@ class DiscEditing:
             >>> sim.run(until=3.0).counts["collisions"], sim.velocities.tolist()
             (1, [[-1.0, 0.0], [1.0, 0.0]])
         """
+        self._check_editable("add discs")
         self._check_usable()
         if not isinstance(discs, Discs):
             msg = f"add_discs needs a discsim.Discs, got {type(discs).__name__} {str(discs)[:60]}"
@@ -198,6 +205,7 @@ class DiscEditing:
             >>> sim.ids.tolist(), sim.run(until=2.9).counts["collisions"], sim.velocities.tolist()
             ([0, 2], 1, [[-1.0, 0.0], [1.0, 0.0]])
         """
+        self._check_editable("remove discs")
         idx = self._disc_indices(indices)
         self._check_usable()
         if not len(idx):
@@ -258,6 +266,7 @@ class DiscEditing:
         Raises:
             InvalidArgumentError: an unknown kind (naming it) or a ``fn`` that is not callable.
         """
+        self._check_editable("follow events with on()")
         if not isinstance(kind, str) or kind not in self.CALLBACK_KINDS:
             msg = f"on() follows one of {list(self.CALLBACK_KINDS)}, got {kind!r}"
             raise InvalidArgumentError(msg)

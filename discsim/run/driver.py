@@ -131,7 +131,7 @@ def drive(
     """
     engine._check_usable()
     unit = engine.unit
-    stop, limit = run_limits(until, limit, engine.time, unit)
+    stop, limit = run_limits(until, limit, engine.time, unit, ends=engine.runs_to_end)
     if checkpoint_every is not None and (not is_count(checkpoint_every) or checkpoint_every == 0):
         msg = f"checkpoint_every must be a positive integer ({unit}), got {checkpoint_every!r}"
         raise InvalidArgumentError(msg)
@@ -160,15 +160,16 @@ def drive(
     return _drive_chunks(engine, plan, chain, stream)
 
 
-def run_limits(until, limit, now: float, unit: str) -> tuple[float, int | None]:
+def run_limits(until, limit, now: float, unit: str, *, ends: bool = False) -> tuple[float, int | None]:
     """``(stop, limit)`` from ``run(until=..., events=...)``: the one internal spelling of the limits.
 
     ``stop`` is a float, ``math.inf`` for no stop time (``until`` None, or ``inf`` with a count); ``limit``
-    an int >= 0, or None for no count.
+    an int >= 0, or None for no count. ``ends``: the engine's work ends by itself
+    (``Engine.runs_to_end``), so neither limit means "to the end".
 
     Raises:
         TimeError: ``until`` before ``now``, NaN or not a number, or infinite without a count.
-        InvalidArgumentError: a count that is not a whole number >= 0, or neither limit.
+        InvalidArgumentError: a count that is not a whole number >= 0, or neither limit (unless ``ends``).
 
     Example:
         >>> run_limits(None, 5, 0.0, "events"), run_limits(2.0, None, 0.0, "events")
@@ -176,10 +177,10 @@ def run_limits(until, limit, now: float, unit: str) -> tuple[float, int | None]:
     """
     until = check_until(until, now)
     limit = check_count(unit, limit)
-    if until is None and limit is None:
+    if until is None and limit is None and not ends:
         msg = f"run() needs until=... or {unit}=..."
         raise InvalidArgumentError(msg)
-    if until == math.inf and limit is None:
+    if until == math.inf and limit is None and not ends:
         msg = f"run(until=inf) never ends: give a finite until or {unit}=..."
         raise TimeError(msg)
     return (math.inf if until is None else until), limit

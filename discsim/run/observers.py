@@ -96,23 +96,25 @@ class Callback(Observer):
 
 
 class ProgressBar(Observer):
-    """A progress bar over simulated time (runs with ``until`` only) or units of work, with a rate."""
+    """A progress bar over simulated time (runs with ``until`` only) or units of work, with a rate.
+
+    What it measures is the engine's (``engine._progress(plan)``): a compression shows its packing.
+    """
 
     def start(self, engine, plan) -> None:
-        self._by_time = plan.limit is None
-        total = plan.until - plan.start_time if self._by_time else plan.limit
-        self._context = progress_bar(total, self._by_time, unit=engine.unit, rate=engine.rate_count)
+        self._plan = plan
+        self._at, total, by_time, unit = engine._progress(plan)
+        self._context = progress_bar(total, by_time, unit=unit, rate=engine.rate_count)
         self._bar = self._context.__enter__()
         self._bar.start(engine.counts[engine.rate_count])
-        self._time = engine.time
 
     def next_stop(self, engine) -> int:
         return engine.progress_chunk
 
     def update(self, engine, events, done, finishing) -> None:
-        amount = engine.time - self._time if self._by_time else done
-        self._time = engine.time
-        self._bar.update(amount, engine.counts[engine.rate_count])
+        at = engine._progress(self._plan)[0]
+        self._bar.update(at - self._at, engine.counts[engine.rate_count])
+        self._at = at
 
     def finish(self, engine, completed) -> None:
         self._context.__exit__(None, None, None)

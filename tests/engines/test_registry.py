@@ -38,14 +38,15 @@ def _engine_classes() -> dict[str, type]:
 
 def test_the_registry_knows_every_engine():
     defined = _engine_classes()
-    assert set(defined) >= {"EventDriven", "FixedStep"}
+    assert set(defined) >= {"Compression", "EventDriven", "FixedStep"}
     assert base.registered_engines() == defined
     for name, cls in defined.items():
         assert base.engine_class(name) is cls
 
 
 def test_an_unknown_name_is_refused_naming_the_known_ones():
-    with pytest.raises(ds.InvalidArgumentError, match=r"'Nope' \(known: \['EventDriven', 'FixedStep'\]\)"):
+    known = r"'Nope' \(known: \['Compression', 'EventDriven', 'FixedStep'\]\)"
+    with pytest.raises(ds.InvalidArgumentError, match=known):
         base.engine_class("Nope")
 
 
@@ -87,7 +88,7 @@ def test_the_old_table_of_engines_still_answers_with_a_warning():
 
     with pytest.warns(DeprecationWarning, match="registered_engines"):
         engines = checkpoints.ENGINES
-    assert engines == {"EventDriven": ds.EventDriven, "FixedStep": ds.FixedStep}
+    assert engines == {"Compression": ds.Compression, "EventDriven": ds.EventDriven, "FixedStep": ds.FixedStep}
 
 
 def test_an_engine_module_imported_alone_runs_and_saves(tmp_path):

@@ -1,9 +1,12 @@
-"""Compression by growing discs (Lubachevsky-Stillinger): :func:`compress` and its :class:`CompressionReport`.
+"""Compression by growing discs (Lubachevsky-Stillinger): the :class:`Compression` engine and :func:`compress`.
 
-``engine.py`` validates, runs the thermostat epochs and checks the result; ``loop.py`` is the event loop of
-one epoch, in pure Python, and ``compiled.py`` the same source compiled by numba when it imports.
+``engine.py`` is the engine (validation, the thermostat epochs, the state the driver and checkpoints see)
+and :func:`compress`, its one-call form; ``report.py`` the :class:`CompressionReport`; ``epoch.py`` one
+epoch and the final shrink; ``loop.py`` the event loop of one epoch, in pure Python, and ``compiled.py``
+the same source compiled by numba when it imports.
 """
 
-from discsim.engines.compress.engine import DENSEST_PACKING, CompressionReport, compress
+from discsim.engines.compress.engine import Compression, compress
+from discsim.engines.compress.report import DENSEST_PACKING, CompressionReport
 
-__all__ = ["DENSEST_PACKING", "CompressionReport", "compress"]
+__all__ = ["DENSEST_PACKING", "Compression", "CompressionReport", "compress"]

@@ -1,6 +1,9 @@
-"""``compress``: grow the discs to a target packing fraction (Lubachevsky-Stillinger), exactly event-driven.
+"""Compression as an engine: :class:`Compression` grows the discs epoch by epoch, run by the driver.
 
-See :func:`compress`. The loop itself is :mod:`.loop` (pure Python on lists, or compiled by numba).
+The driver (:mod:`discsim.run.driver`) runs it as it runs any engine: ``run()`` to the end, or
+``run(epochs=k)``, with a progress bar over the packing, observers and checkpoints between epochs, and
+Ctrl-C stopping it after the epoch under way. :func:`compress` is the one-call form: build, run to the end,
+return the discs and the report. The event loop of one epoch is :mod:`.loop`, wrapped by :mod:`.epoch`.
 """
 
 from __future__ import annotations
@@ -8,100 +11,409 @@ from __future__ import annotations
 import math
 import time as _time
 from dataclasses import dataclass
+from typing import Any, ClassVar, NoReturn
 
 import numpy as np
 
 from discsim import _numba
-from discsim.cells import grid_shape, neighbour_pairs
-from discsim.engines.compress import loop
-from discsim.errors import InvalidArgumentError, PackingError, WrongTypeError
-from discsim.model import Box, Discs
-from discsim.scene import check_fits
+from discsim._interrupt import deferred_interrupt
+from discsim.cells import grid_shape
+from discsim.engines.base import Engine, EngineState, register_engine
+from discsim.engines.compress.epoch import epoch, shrink_factor
+from discsim.engines.compress.report import DENSEST_PACKING, HISTORY, CompressionReport
+from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError, PackingError, WrongTypeError
+from discsim.model import Box, Discs, _readonly
+from discsim.scene import Scene, check_fits
 
-__all__ = ["DENSEST_PACKING", "CompressionReport", "compress"]
+__all__ = ["Compression", "CompressionState", "compress"]
 
-#: The densest packing of equal discs in the plane, the triangular lattice: pi / (2 sqrt 3) = 0.9069.
-DENSEST_PACKING = math.pi / (2.0 * math.sqrt(3.0))
-#: Relative shrink of all radii at the end, beyond the smallest gap, when roundoff left a contact inside.
-SHRINK = 1e-12
-_HISTORY = np.dtype([("packing", "f8"), ("collisions", "i8"), ("seconds", "f8"), ("z", "f8"), ("time", "f8")])
+#: Why a compression stopped; "" while it runs.
+REASONS = ("", "reached", "jammed", "max_collisions")
 
 
-@dataclass(frozen=True)
-class CompressionReport:
-    """What :func:`compress` did.
+@dataclass
+class CompressionState(EngineState):
+    """The run state of a :class:`Compression` between two epochs: everything it needs to go on bit for bit.
 
     Attributes:
-        packing_fraction: the packing reached (after the final shrink, if any).
-        target: the packing asked for.
-        reached: True when the target was reached (to within the final shrink).
-        jammed: True when the compression stopped because the pressure diverged below the target.
-        reason: ``"reached"``, ``"jammed"`` or ``"max_collisions"``.
-        collisions: disc-disc collisions in all. wall_events: disc-wall collisions.
-        time: simulated time of the compression. seconds: wall-clock time.
-        z: the reduced pressure ``PA / NkT`` (collision virial) of the last epoch; it diverges at jamming.
-        epochs: thermostat epochs run. shrink: the factor the radii were scaled by at the end (1.0: none).
-        backend: ``"python"`` or ``"numba"``.
-        history: one row per epoch: packing, collisions so far, seconds so far, Z, simulated time.
+        positions: ``(N, 2)`` centres where the last epoch left them (wrapped at the next epoch's start).
+        shift: ``(N, 2)`` what the wrapping took off so far: unwrapped centres are ``positions + shift``.
+        velocities: ``(N, 2)`` velocities where the last epoch left them (before the next thermostat).
+        radii: ``(N,)`` radii now. packing: their packing fraction.
+        time: simulated time. collisions, walls, epochs: counts. z: the last epoch's reduced pressure.
+        seconds: wall-clock seconds spent in epochs. reason: why it stopped (:data:`REASONS`; "" running).
+        history: ``(epochs, 5)`` one row per epoch: packing, collisions, seconds, Z, time.
     """
 
-    packing_fraction: float
-    target: float
-    reached: bool
-    jammed: bool
-    reason: str
-    collisions: int
-    wall_events: int
+    positions: np.ndarray
+    shift: np.ndarray
+    velocities: np.ndarray
+    radii: np.ndarray
+    packing: float
     time: float
-    seconds: float
-    z: float
+    collisions: int
+    walls: int
     epochs: int
-    shrink: float
-    backend: str
+    z: float
+    seconds: float
+    reason: str
     history: np.ndarray
 
-    def collisions_to(self, packing: float, n: int) -> float:
-        """Collisions per disc (``n`` discs) spent to reach ``packing``, interpolated between epochs (nan if never)."""
-        h = self.history
-        if len(h) == 0 or h["packing"][-1] < packing * (1.0 - 1e-9):
-            return math.nan
-        k = int(np.searchsorted(h["packing"], packing * (1.0 - 1e-9)))
-        if k == 0:
-            return float(h["collisions"][0]) / n
-        p0, p1 = h["packing"][k - 1], h["packing"][k]
-        c0, c1 = h["collisions"][k - 1], h["collisions"][k]
-        w = (packing - p0) / (p1 - p0) if p1 > p0 else 1.0
-        return float(c0 + w * (c1 - c0)) / n
 
-    def __str__(self) -> str:
-        what = {
-            "reached": "reached",
-            "jammed": "JAMMED below",
-            "max_collisions": "ran out of collisions (max_collisions) below",
-        }[self.reason]
-        return (
-            f"packing {self.packing_fraction:.6f} ({what} the target {self.target:g}) after {self.collisions:,} "
-            f"collisions, simulated time {self.time:.6g}, {self.seconds:.3g} s ({self.backend}), Z = {self.z:.4g}"
+@register_engine
+class Compression(Engine):
+    """Grow all discs until they fill ``packing_fraction`` of the box (Lubachevsky-Stillinger), exactly.
+
+    An engine whose unit of work is a thermostat epoch: ``run()`` goes on to the end (the target, a jam
+    or ``max_collisions``), ``run(epochs=k)`` does ``k`` more, ``run(progress=True)`` shows a bar over the
+    packing, and ``run(checkpoint=path)`` writes checkpoints between epochs that :func:`discsim.resume`
+    continues bit for bit. Ctrl-C stops it after the epoch under way (``ds.Interrupted``), consistent and
+    able to go on. :attr:`report` says where it stands; :meth:`snapshot` gives the discs, valid for
+    ``EventDriven``, at any point. The discs grow, so there is no event log: ``record_to``, ``trajectory``,
+    ``on`` and the disc-editing methods are refused. The physics and the arguments are those of
+    :func:`compress`.
+
+    Args:
+        discs, box, packing_fraction, growth_rate, seed, temperature, max_collisions, max_pressure,
+            epoch_collisions, backend: as for :func:`compress`.
+
+    Example:
+        >>> import discsim as ds
+        >>> gas, box = ds.random_gas(100, 0.3, seed=1)
+        >>> c = ds.Compression(gas, box, 0.6, backend="python")
+        >>> c.run(epochs=2).report.reason, c.run().report.reason, round(c.report.packing_fraction, 6)
+        ('running', 'reached', 0.6)
+    """
+
+    unit: ClassVar[str] = "epochs"
+    rate_count: ClassVar[str] = "collisions"
+    progress_chunk: ClassVar[int] = 1
+    runs_to_end: ClassVar[bool] = True
+    STATE = CompressionState
+
+    def __init__(
+        self,
+        discs: Discs,
+        box: Box,
+        packing_fraction: float,
+        growth_rate: float = 0.01,
+        seed: int | None = None,
+        *,
+        temperature: float = 1.0,
+        max_collisions: int | None = None,
+        max_pressure: float = 1e5,
+        epoch_collisions: int | None = None,
+        backend: str = "auto",
+    ):
+        if not isinstance(discs, Discs):
+            msg = f"discs must be a discsim.Discs, got {type(discs).__name__}"
+            raise WrongTypeError(msg)
+        if not isinstance(box, Box):
+            msg = f"box must be a discsim.Box, got {type(box).__name__}"
+            raise WrongTypeError(msg)
+        settings: dict[str, Any] = {
+            "target": _target(packing_fraction, discs, box),
+            "growth_rate": _positive("growth_rate", growth_rate),
+            "temperature": _positive("temperature", temperature),
+            "max_pressure": _positive("max_pressure", max_pressure),
+            "max_collisions": _count("max_collisions", max_collisions),
+            "epoch_collisions": _count("epoch_collisions", epoch_collisions) or max(2 * len(discs), 100),
+            "backend": _numba.resolve_backend(backend, ("python", "numba"), "compress"),
+        }
+        masses = np.asarray(discs.masses, dtype=float)
+        if not np.isfinite(masses).all():
+            i = int(np.flatnonzero(~np.isfinite(masses))[0])
+            msg = f"disc {i} has mass {masses[i]!r}: compress moves every disc, so masses must be finite"
+            raise InvalidArgumentError(msg)
+        check_fits(discs, box)
+        self._configure(Scene(discs, box), settings)
+        n, temperature = len(discs), settings["temperature"]
+        velocities = np.array(discs.velocities, dtype=float)
+        if seed is not None or not velocities.any():
+            rng = np.random.default_rng(seed)
+            velocities = rng.normal(size=(n, 2)) * np.sqrt(temperature / masses)[:, None]
+            if n > 1:
+                velocities -= (masses[:, None] * velocities).sum(axis=0) / masses.sum()
+        positions = np.array(discs.positions, dtype=float)
+        radii = np.array(discs.radii, dtype=float)
+        self._state = CompressionState(
+            positions, np.zeros_like(positions), velocities, radii, self._phi0, 0.0, 0, 0, 0, 1.0, 0.0, "",
+            np.zeros((0, 5)),
+        )  # fmt: skip
+
+    def _configure(self, scene: Scene, settings: dict) -> None:
+        """Set the engine up for ``scene`` and ``settings`` (checked): the cell grid, the fixed quantities."""
+        super().__init__(scene, record=False)
+        self.settings = settings
+        self.backend = settings["backend"]
+        discs, box = scene.discs, scene.box
+        self._area = box.width * box.height
+        self._masses = np.array(discs.masses, dtype=float)
+        self._phi0 = math.pi * float(np.sum(np.asarray(discs.radii, dtype=float) ** 2)) / self._area
+        final = math.sqrt(settings["target"] / self._phi0)
+        self._grid = grid_shape(
+            box,
+            2.0 * float(np.max(discs.radii)) * final * (1.0 + 1e-9),
+            max(4 * len(discs), 64),
+            what="the largest contact distance at the target packing",
         )
 
+    # --- where it stands --------------------------------------------------------------------
+    @property
+    def time(self) -> float:  # type: ignore[override]
+        """Simulated time of the compression so far."""
+        return self._state.time
 
-def _positive(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        msg = f"{name} must be a positive, finite number, got {value!r}"
-        raise InvalidArgumentError(msg)
-    if not (0.0 < value < math.inf):
-        msg = f"{name} must be positive and finite, got {value!r}"
-        raise InvalidArgumentError(msg)
-    return float(value)
+    @time.setter
+    def time(self, value: float) -> None:  # the driver settles runs with a stop time; compressions have none
+        if value != self._state.time:
+            msg = "a compression's clock moves only by whole epochs"
+            raise InvalidArgumentError(msg)
 
+    @property
+    def finished(self) -> bool:
+        """True once the compression stopped: the target reached, a jam, or ``max_collisions`` spent."""
+        return self._state.reason != ""
 
-def _count(name: str, value) -> int | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        msg = f"{name} must be a positive integer or None, got {value!r}"
-        raise InvalidArgumentError(msg)
-    return int(value)
+    @property
+    def radii(self) -> np.ndarray:
+        """``(N,)`` radii now (before the final shrink :meth:`snapshot` applies)."""
+        return _readonly(self._state.radii.copy())
+
+    @property
+    def positions(self) -> np.ndarray:
+        """``(N, 2)`` centres now (wrapped into a periodic box)."""
+        p = self._state.positions
+        return _readonly(self.box.wrap(p) if self.box.periodic else p.copy())
+
+    @property
+    def unwrapped_positions(self) -> np.ndarray:
+        """``(N, 2)`` centres now, each disc followed across the edges of a periodic box."""
+        return _readonly(self._state.positions + self._state.shift)
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """``(N, 2)`` velocities now, at the thermostat's ``kT`` (as the next epoch starts them)."""
+        return _readonly(self._thermostat(self._state.velocities)[0])
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """``collisions`` (disc with disc), ``wall_events`` and ``epochs`` so far."""
+        s = self._state
+        return {"collisions": s.collisions, "wall_events": s.walls, "epochs": s.epochs}
+
+    @property
+    def report(self) -> CompressionReport:
+        """A :class:`CompressionReport` of the compression so far (``reason`` ``"running"`` until it stops)."""
+        s = self._state
+        shrink = shrink_factor(self.positions, s.radii, self.box)
+        radii = s.radii * shrink
+        history = np.zeros(len(s.history), dtype=HISTORY)
+        for k, name in enumerate(HISTORY.names or ()):
+            history[name] = s.history[:, k]
+        return CompressionReport(
+            packing_fraction=math.pi * float(np.sum(radii**2)) / self._area,
+            target=self.settings["target"],
+            reached=s.reason == "reached",
+            jammed=s.reason == "jammed",
+            reason=s.reason or "running",
+            collisions=s.collisions,
+            wall_events=s.walls,
+            time=s.time,
+            seconds=s.seconds,
+            z=s.z,
+            epochs=s.epochs,
+            shrink=shrink,
+            backend=self.backend,
+            history=history,
+        )
+
+    def snapshot(self) -> Discs:
+        """The discs now, valid for ``EventDriven``: radii shrunk past any contact roundoff left a hair inside
+        (by the report's ``shrink``), velocities at ``kT`` (same masses and groups)."""
+        s, d = self._state, self.discs
+        radii = s.radii * shrink_factor(self.positions, s.radii, self.box)
+        return Discs(self.positions, self.velocities, radii, d.masses, d.groups)
+
+    # --- the driver's protocol ---------------------------------------------------------------
+    def _advance(self, until: float, limit: int | None) -> int:
+        """Run up to ``limit`` epochs (None: to the end); ``until`` is inf (runs take no stop time)."""
+        done = 0
+        with deferred_interrupt() as interrupted:
+            while not self.finished and (limit is None or done < limit) and not interrupted[0]:
+                self._epoch()
+                done += 1
+        return done
+
+    def _units(self) -> int:
+        return self._state.epochs
+
+    def _event_count(self) -> int:
+        return 0
+
+    def step(self) -> CompressionReport:
+        """Run one epoch (none once finished) and return the :attr:`report`."""
+        self._check_usable()
+        self._advance(math.inf, 1)
+        return self.report
+
+    def run(
+        self,
+        until: float | None = None,
+        *,
+        epochs: int | None = None,
+        events: int | None = None,
+        observers=(),
+        progress: bool = False,
+        record_to=None,
+        checkpoint=None,
+        checkpoint_every: int | None = None,
+    ):
+        """Run to the end (no arguments) or for ``epochs`` more epochs; see :func:`discsim.run.driver.drive`.
+
+        Args:
+            until: not taken: a compression runs by epochs (an epoch cut short would change the result).
+            epochs: epochs to run (None: to the end). events: another name for ``epochs`` (:func:`resume`).
+            observers, progress, checkpoint, checkpoint_every: as for ``Engine.run`` (``progress`` shows
+                the way from the packing at the start to the target; ``checkpoint_every`` counts epochs).
+            record_to: not taken: the compression keeps no event log.
+
+        Returns:
+            ``self``, so calls chain.
+
+        Raises:
+            InvalidArgumentError: ``until`` or ``record_to`` given, ``epochs`` not a whole number >= 0, or
+                ``epochs`` and ``events`` both given.
+        """
+        if until is not None:
+            msg = f"a compression runs by epochs, not to a time: give epochs=... or nothing, not until={until!r}"
+            raise InvalidArgumentError(msg)
+        if record_to is not None:
+            msg = "a compression keeps no event log (the discs grow): record_to is not taken"
+            raise InvalidArgumentError(msg)
+        if events is not None:
+            if epochs is not None:
+                msg = f"give epochs=... or events=..., not both: epochs={epochs!r}, events={events!r}"
+                raise InvalidArgumentError(msg)
+            epochs = events
+        return super().run(
+            None,
+            events=epochs,
+            observers=observers,
+            progress=progress,
+            checkpoint=checkpoint,
+            checkpoint_every=checkpoint_every,
+        )
+
+    def _progress(self, plan) -> tuple[float, float, bool, str]:
+        """A progress bar from the packing at the start to the target, in percent of the way."""
+        target = self.settings["target"]
+        shown = min(100.0, 100.0 * (self._state.packing - self._phi0) / (target - self._phi0))
+        return shown, 100.0, False, "%"
+
+    # --- one epoch ----------------------------------------------------------------------------------
+    def _thermostat(self, velocities: np.ndarray) -> tuple[np.ndarray, float]:
+        """``(velocities at kT, their kinetic energy before)``: all rescaled by one factor."""
+        n = len(velocities)
+        energy = 0.5 * float(np.sum(self._masses[:, None] * velocities**2))
+        if energy > 0:
+            velocities = velocities * math.sqrt(n * self.settings["temperature"] / energy)
+        return velocities, energy
+
+    def _epoch(self) -> None:
+        """Thermostat, one epoch of growing discs, and the new state (set at once: Ctrl-C never splits it)."""
+        started = _time.perf_counter()
+        s, settings, box = self._state, self.settings, self.box
+        n = len(s.radii)
+        velocities, energy = self._thermostat(s.velocities)
+        g = settings["growth_rate"] * math.sqrt(settings["temperature"] / float(self._masses.mean()))
+        g /= 2.0 * float(s.radii.mean())
+        target = settings["target"]
+        t_end = (math.sqrt(target / s.packing) - 1.0) / g
+        budget = settings["epoch_collisions"]
+        if settings["max_collisions"] is not None:
+            budget = min(budget, settings["max_collisions"] - s.collisions)
+        start = box.wrap(s.positions) if box.periodic else s.positions
+        positions, new_velocities, t, stats = epoch(
+            start, velocities, s.radii, self._masses, box, self._grid, g, t_end, budget, self.backend
+        )
+        done = stats["collisions"]
+        collisions = s.collisions + done
+        kt = 0.5 * (energy + 0.5 * float(np.sum(self._masses[:, None] * new_velocities**2))) / n
+        at_end = t >= t_end
+        if at_end:
+            radii, packing = s.radii * math.sqrt(target / s.packing), target
+        else:
+            radii = s.radii * (1.0 + g * t)
+            packing = math.pi * float(np.sum(radii**2)) / self._area
+        z = s.z
+        if t > 0:
+            z = 1.0 + stats["virial"] / (2.0 * n * kt * t)
+        elif done or stats["walls"]:
+            z = math.inf  # collisions without the clock moving
+        reason = ""
+        if at_end:
+            reason = "reached"
+        elif z > settings["max_pressure"]:
+            reason = "jammed"
+        elif settings["max_collisions"] is not None and collisions >= settings["max_collisions"]:
+            reason = "max_collisions"
+        seconds = s.seconds + (_time.perf_counter() - started)
+        row = np.array([[packing, collisions, seconds, z, s.time + t]])
+        self._state = CompressionState(
+            positions, s.shift + (s.positions - start), new_velocities, radii, packing, s.time + t, collisions,
+            s.walls + stats["walls"], s.epochs + 1, z, seconds, reason, np.concatenate([s.history, row]),
+        )  # fmt: skip
+
+    # --- the checkpoint's protocol -------------------------------------------------------------
+    def state(self) -> CompressionState:
+        s = self._state
+        return CompressionState(
+            s.positions.copy(), s.shift.copy(), s.velocities.copy(), s.radii.copy(), s.packing, s.time,
+            s.collisions, s.walls, s.epochs, s.z, s.seconds, s.reason, s.history.copy(),
+        )  # fmt: skip
+
+    def _settings(self) -> dict:
+        return dict(self.settings)
+
+    @classmethod
+    def _restore(cls, scene, settings, state, events, start_time) -> Compression:
+        sim = cls.__new__(cls)
+        settings = {k: v for k, v in settings.items() if k != "record"}
+        settings["backend"] = _numba.resolve_backend(settings.get("backend", "auto"), ("python", "numba"), "load")
+        sim._configure(scene, settings)
+        n = len(scene)
+        shapes = {"positions": (n, 2), "shift": (n, 2), "velocities": (n, 2), "radii": (n,)}
+        for name, shape in shapes.items():
+            if np.shape(getattr(state, name)) != shape:
+                msg = f"the state's {name} has shape {np.shape(getattr(state, name))}, not {shape}"
+                raise CheckpointError(msg)
+        if state.reason not in REASONS or np.shape(state.history) != (state.epochs, 5):
+            msg = f"the state's reason {state.reason!r} or history {np.shape(state.history)} is not a compression's"
+            raise CheckpointError(msg)
+        sim._state = state
+        return sim
+
+    # --- refused ------------------------------------------------------------------------------
+    def _set_discs(self, indices, positions, velocities) -> None:
+        self._refuse("change discs")
+
+    def _restructure(self, keep, added, scene) -> None:
+        self._refuse("add or remove discs")
+
+    def _check_editable(self, what: str) -> None:
+        self._refuse(what)
+
+    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
+        """Refused: a compression keeps no event log."""
+        self._refuse("give trajectories")
+
+    def _refuse(self, what: str) -> NoReturn:
+        msg = (
+            f"a Compression cannot {what}: the discs grow and no log is kept; compress first, then build an "
+            "EventDriven from compression.snapshot()"
+        )
+        raise DiscsimError(msg)
 
 
 def compress(
@@ -136,17 +448,23 @@ def compress(
     The compression stops when the target is reached, or, below it, when the reduced pressure ``Z``
     (collision virial of an epoch) exceeds ``max_pressure`` (the packing has jammed: free-volume theory
     puts the jamming packing within about ``2 phi / Z`` of the packing reached), or after
-    ``max_collisions``. The report says which, with the packing reached; nothing is raised.
+    ``max_collisions``. The report says which, with the packing reached; nothing is raised. A target at
+    which a disc would span a walled box is refused, an epoch also ends after ``epoch_collisions`` wall hits,
+    and an epoch whose clock did not move (discs wedged across a channel) is a jam, so a run always ends.
 
     At the end, if roundoff left a contact a hair inside (a relative 1e-16 or so), all radii shrink by
     that much and a relative ``SHRINK`` = 1e-12 more, so that ``EventDriven(discs, box)`` accepts the
     result (the report gives the factor). Velocities are at ``kT = temperature``.
 
+    This is :class:`Compression` run to the end: use that engine for checkpoints, observers, or a
+    compression done a few epochs at a time. Ctrl-C stops it after the epoch under way.
+
     Args:
         discs: the starting discs (no overlaps; finite masses). Velocities are rescaled to ``kT``; all at
             rest, or ``seed`` given, draws new Gaussian velocities (zero total momentum).
         box: the box, periodic or walled.
-        packing_fraction: the target, above the discs' packing now and below 0.9069 (``DENSEST_PACKING``).
+        packing_fraction: the target, above the discs' packing now and below 0.9069 (``DENSEST_PACKING``);
+            in a walled box, low enough that every disc still fits across it.
         growth_rate: mean diameter growth per unit time, in thermal speeds (positive, finite; 0.001-0.1).
         seed: seed of the new velocities, or None to keep the directions given.
         temperature: kT of the thermostat. max_collisions: budget of collisions (None: none).
@@ -159,8 +477,9 @@ def compress(
         ``(discs, report)``: the compressed discs (same masses and groups) and a :class:`CompressionReport`.
 
     Raises:
-        PackingError: a target above 0.9069 or not above the packing now, or (``BoxTooSmallError``) a
-            periodic box under 3 final diameters a side.
+        PackingError: a target above 0.9069 or not above the packing now, or one at which a disc would no
+            longer fit across a walled box, or (``BoxTooSmallError``) a periodic box under 3 final
+            diameters a side.
         InvalidArgumentError: a growth rate, temperature or limit that is not positive and finite; infinite
             masses. OverlapError, OutsideBoxError: discs that do not fit. All before anything runs.
 
@@ -171,19 +490,30 @@ def compress(
         >>> report.reached, round(report.packing_fraction, 6)
         (True, 0.6)
     """
-    if not isinstance(discs, Discs):
-        msg = f"discs must be a discsim.Discs, got {type(discs).__name__}"
-        raise WrongTypeError(msg)
-    if not isinstance(box, Box):
-        msg = f"box must be a discsim.Box, got {type(box).__name__}"
-        raise WrongTypeError(msg)
-    n = len(discs)
-    radii = np.array(discs.radii, dtype=float)
-    area = box.width * box.height
-    phi0 = math.pi * float(np.sum(radii**2)) / area
+    compression = Compression(
+        discs,
+        box,
+        packing_fraction,
+        growth_rate,
+        seed,
+        temperature=temperature,
+        max_collisions=max_collisions,
+        max_pressure=max_pressure,
+        epoch_collisions=epoch_collisions,
+        backend=backend,
+    )
+    compression.run(progress=progress)
+    return compression.snapshot(), compression.report
+
+
+def _target(packing_fraction, discs: Discs, box: Box) -> float:
+    """The checked target packing fraction (a float)."""
     if isinstance(packing_fraction, bool) or not isinstance(packing_fraction, (int, float, np.integer, np.floating)):
         msg = f"packing_fraction must be a number, got {packing_fraction!r}"
         raise PackingError(msg)
+    if len(discs) == 0:
+        msg = "compress needs at least one disc"
+        raise InvalidArgumentError(msg)
     target = float(packing_fraction)
     if not (target < DENSEST_PACKING):  # also nan
         msg = (
@@ -191,214 +521,38 @@ def compress(
             f"pi / (2 sqrt 3) = {DENSEST_PACKING:.6f} (the triangular lattice)"
         )
         raise PackingError(msg)
+    radii = np.asarray(discs.radii, dtype=float)
+    phi0 = math.pi * float(np.sum(radii**2)) / (box.width * box.height)
     if not target > phi0:
         msg = f"packing fraction {packing_fraction!r} is not above the discs' packing now, {phi0:.6g}"
         raise PackingError(msg)
-    growth_rate = _positive("growth_rate", growth_rate)
-    temperature = _positive("temperature", temperature)
-    max_pressure = _positive("max_pressure", max_pressure)
-    max_collisions = _count("max_collisions", max_collisions)
-    epoch_collisions = _count("epoch_collisions", epoch_collisions) or max(2 * n, 100)
-    masses = np.array(discs.masses, dtype=float)
-    if n == 0:
-        msg = "compress needs at least one disc"
-        raise InvalidArgumentError(msg)
-    if not np.isfinite(masses).all():
-        i = int(np.flatnonzero(~np.isfinite(masses))[0])
-        msg = f"disc {i} has mass {masses[i]!r}: compress moves every disc, so masses must be finite"
-        raise InvalidArgumentError(msg)
-    check_fits(discs, box)
-    name = _numba.resolve_backend(backend, ("python", "numba"), "compress")
-    final = math.sqrt(target / phi0)
-    nx, ny = grid_shape(
-        box,
-        2.0 * float(radii.max()) * final * (1.0 + 1e-9),
-        max(4 * n, 64),
-        what="the largest contact distance at the target packing",
-    )
-
-    mean_mass = float(masses.mean())
-    velocities = np.array(discs.velocities, dtype=float)
-    if seed is not None or not velocities.any():
-        rng = np.random.default_rng(seed)
-        velocities = rng.normal(size=(n, 2)) * np.sqrt(temperature / masses)[:, None]
-        if n > 1:
-            velocities -= (masses[:, None] * velocities).sum(axis=0) / masses.sum()
-    positions = np.array(discs.positions, dtype=float)
-
-    v_thermal = math.sqrt(temperature / mean_mass)
-    history = []
-    collisions = walls = epochs = 0
-    sim_time = 0.0
-    z = 1.0
-    reason = "reached"
-    phi = phi0
-    start = _time.perf_counter()
-    bar_context = None
-    if progress:
-        from discsim._progress import progress_bar
-
-        bar_context = progress_bar(100.0, by_time=False, unit="%")
-        bar = bar_context.__enter__()
-        bar.start(0)
-        bar_at = 0.0
-    try:
-        while True:
-            energy = 0.5 * float(np.sum(masses[:, None] * velocities**2))
-            if energy > 0:
-                velocities *= math.sqrt(n * temperature / energy)  # the thermostat
-            g = growth_rate * v_thermal / (2.0 * float(radii.mean()))
-            t_end = (math.sqrt(target / phi) - 1.0) / g
-            budget = epoch_collisions
-            if max_collisions is not None:
-                budget = min(budget, max_collisions - collisions)
-            positions, new_velocities, t, stats = epoch(
-                positions, velocities, radii, masses, box, (nx, ny), g, t_end, budget, name
-            )
-            epochs += 1
-            done = stats["collisions"]
-            collisions += done
-            walls += stats["walls"]
-            sim_time += t
-            kt = 0.5 * (energy + 0.5 * float(np.sum(masses[:, None] * new_velocities**2))) / n
-            velocities = new_velocities
-            at_end = t >= t_end
-            if at_end:
-                radii = radii * math.sqrt(target / phi)
-                phi = target
-            else:
-                radii = radii * (1.0 + g * t)
-                phi = math.pi * float(np.sum(radii**2)) / area
-            if t > 0:
-                z = 1.0 + stats["virial"] / (2.0 * n * kt * t)
-            elif done:
-                z = math.inf  # collisions without the clock moving
-            history.append((phi, collisions, _time.perf_counter() - start, z, sim_time))
-            if progress:
-                shown = min(100.0, 100.0 * (phi - phi0) / (target - phi0))  # percent of the way
-                bar.update(shown - bar_at, collisions)
-                bar_at = shown
-            if at_end:
-                break
-            if z > max_pressure:
-                reason = "jammed"
-                break
-            if max_collisions is not None and collisions >= max_collisions:
-                reason = "max_collisions"
-                break
-    finally:
-        if bar_context is not None:
-            bar_context.__exit__(None, None, None)
-
-    if box.periodic:
-        positions = box.wrap(positions)
-    shrink = _shrink(positions, radii, box)
-    radii = radii * shrink
-    energy = 0.5 * float(np.sum(masses[:, None] * velocities**2))
-    if energy > 0:
-        velocities *= math.sqrt(n * temperature / energy)
-    result = Discs(positions, velocities, radii, discs.masses, discs.groups)
-    reached = math.pi * float(np.sum(radii**2)) / area
-    report = CompressionReport(
-        packing_fraction=reached,
-        target=target,
-        reached=reason == "reached",
-        jammed=reason == "jammed",
-        reason=reason,
-        collisions=collisions,
-        wall_events=walls,
-        time=sim_time,
-        seconds=_time.perf_counter() - start,
-        z=z,
-        epochs=epochs,
-        shrink=shrink,
-        backend=name,
-        history=np.array(history, dtype=_HISTORY),
-    )
-    return result, report
-
-
-def epoch(positions, velocities, radii, masses, box: Box, grid: tuple[int, int], g, t_end, budget, backend):
-    """One epoch of growing discs from time 0 (radii ``radii * (1 + g t)``) to ``t_end`` or ``budget`` collisions.
-
-    Returns:
-        ``(positions, velocities, t, stats)`` at the stopping time ``t`` (positions not wrapped), with
-        ``stats``: ``collisions``, ``walls``, ``crossings``, ``stale`` (counts) and ``virial`` (the sum of
-        impulse times contact distance over the collisions) and ``wall_virial``.
-    """
-    n = len(radii)
-    nx, ny = grid
-    if backend == "numba":
-        from discsim.engines.compress import compiled
-
-        run_epoch = compiled.run_epoch
-
-        def floats(a):  # a fresh array: the loop writes into each
-            return np.array(a, dtype=np.float64)
-
-        def ints(a):
-            return np.array(a, dtype=np.int64)
-    else:  # plain lists: the pure-Python loop indexes them 3-5x faster than numpy arrays
-        run_epoch = loop.run_epoch
-
-        def floats(a):
-            return [float(v) for v in a]
-
-        def ints(a):
-            return [int(v) for v in a]
-
-    if box.periodic:
-        positions = box.wrap(positions)
-    cw, ch = box.width / nx, box.height / ny
-    cells = np.clip((positions[:, 0] / cw).astype(np.int64), 0, nx - 1) * ny + np.clip(
-        (positions[:, 1] / ch).astype(np.int64), 0, ny - 1
-    )
-    head, nxt, prv = _cell_lists(cells, nx * ny)
-    x, y = floats(positions[:, 0]), floats(positions[:, 1])
-    vx, vy = floats(velocities[:, 0]), floats(velocities[:, 1])
-    out, iout = floats([0.0, 0.0, 0.0]), ints([0, 0, 0, 0])
-    zeros = np.zeros(n, dtype=np.int64)
-    t = run_epoch(
-        x, y, vx, vy, floats(np.zeros(n)), floats(radii), floats(masses), ints(zeros), ints(cells), ints(head),
-        ints(nxt), ints(prv), ints(zeros), floats(np.zeros(n)), ints(zeros), ints(zeros), ints(zeros), ints(zeros),
-        floats([box.width, box.height, g, t_end, cw, ch]), ints([nx, ny, int(box.periodic), budget]), out, iout,
-    )  # fmt: skip
-    positions = np.column_stack([np.asarray(x, dtype=float), np.asarray(y, dtype=float)])
-    velocities = np.column_stack([np.asarray(vx, dtype=float), np.asarray(vy, dtype=float)])
-    stats = {
-        "collisions": int(iout[0]),
-        "walls": int(iout[1]),
-        "crossings": int(iout[2]),
-        "stale": int(iout[3]),
-        "virial": float(out[1]),
-        "wall_virial": float(out[2]),
-    }
-    return positions, velocities, float(t), stats
-
-
-def _cell_lists(cells: np.ndarray, size: int):
-    """``head`` (first disc of each cell, -1 if none), ``nxt`` and ``prv``: doubly linked lists by cell, numpy only."""
-    order = np.argsort(cells, kind="stable")
-    ordered = cells[order]
-    same = ordered[1:] == ordered[:-1]
-    nxt = np.full(len(cells), -1, dtype=np.int64)
-    prv = np.full(len(cells), -1, dtype=np.int64)
-    nxt[order[:-1][same]] = order[1:][same]
-    prv[order[1:][same]] = order[:-1][same]
-    head = np.full(size, -1, dtype=np.int64)
-    first = np.ones(len(cells), dtype=bool)
-    first[1:] = ~same
-    head[ordered[first]] = order[first]
-    return head, nxt, prv
-
-
-def _shrink(positions: np.ndarray, radii: np.ndarray, box: Box) -> float:
-    """1.0, or the factor that leaves every pair and wall a relative ``SHRINK`` apart if one is not."""
-    i, j, d = neighbour_pairs(positions, 2.0 * float(radii.max()) * (1.0 + 1e-9), box)
-    ratio = 1.0 if len(i) == 0 else float(np.min(np.hypot(d[:, 0], d[:, 1]) / (radii[i] + radii[j])))
     if not box.periodic:
-        gaps = np.minimum(positions, box.size - positions) / radii[:, None]
-        ratio = min(ratio, float(gaps.min()))
-    if ratio >= 1.0 + SHRINK:
-        return 1.0
-    return min(ratio, 1.0) * (1.0 - SHRINK)
+        i = int(np.argmax(radii))
+        final = 2.0 * float(radii[i]) * math.sqrt(target / phi0)
+        side = min(box.width, box.height)
+        if final >= side:
+            msg = (
+                f"packing fraction {packing_fraction!r} cannot be reached in this walled box: disc {i} would "
+                f"grow to a diameter of {final:.6g}, not less than the box's side {side:g}"
+            )
+            raise PackingError(msg)
+    return target
+
+
+def _positive(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        msg = f"{name} must be a positive, finite number, got {value!r}"
+        raise InvalidArgumentError(msg)
+    if not (0.0 < value < math.inf):
+        msg = f"{name} must be positive and finite, got {value!r}"
+        raise InvalidArgumentError(msg)
+    return float(value)
+
+
+def _count(name: str, value) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        msg = f"{name} must be a positive integer or None, got {value!r}"
+        raise InvalidArgumentError(msg)
+    return int(value)

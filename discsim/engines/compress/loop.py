@@ -7,7 +7,8 @@ Every function here uses only indexing, arithmetic and :mod:`math`, so the same 
 
 One call of :func:`run_epoch` runs the dynamics of one epoch: all discs start synchronised at epoch time 0,
 radius ``r0[i] * (1 + g t)`` at epoch time ``t``, and the loop stops at ``t_end`` or after ``max_coll``
-collisions, with every disc advanced to the stopping time. Between epochs the caller rescales the
+collisions or ``max_coll`` wall hits (a disc squeezed between two walls hits them ever faster), with every
+disc advanced to the stopping time. Between epochs the caller rescales the
 velocities (the thermostat) and rebases the radii, so all predictions start afresh.
 
 Data (per disc ``i``): ``x, y, vx, vy`` at time ``tr[i]`` (a lazy clock), ``r0`` (radius at epoch time 0),
@@ -233,7 +234,7 @@ def run_epoch(x, y, vx, vy, tr, r0, m, count, cell, head, nxt, prv, heap, ht, hp
     while n > 0:
         i = heap[0]
         t = ht[0]
-        if collisions >= max_coll:  # stop at the last collision
+        if collisions >= max_coll or walls >= max_coll:  # stop at the last collision (or wall hit)
             break
         if t >= t_end:
             t_last = t_end

@@ -37,15 +37,17 @@ from discsim._numba import resolve_backend
 from discsim._validate import check_count, positive_finite
 from discsim.cells import CellGrid
 from discsim.engines.base import Engine, register_engine
-from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
+from discsim.engines.fixed_step.arrays import Shapes
 from discsim.engines.fixed_step.broad_phase import BROAD_PHASE_CLASSES
 from discsim.engines.fixed_step.frame import FRAME_POLICY_CLASSES
+from discsim.engines.fixed_step.readout import FrameReadout
+from discsim.engines.fixed_step.run_state import FixedStepRun
 from discsim.engines.fixed_step.state import FixedStepState
 from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisect
 from discsim.engines.record import collision_virials
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
-from discsim.model import Box, Discs, _readonly, frame_count
+from discsim.model import Box, Discs, frame_count
 from discsim.scene import Scene
 
 __all__ = ["BACKENDS", "BROAD_PHASES", "COMPILED_POLICIES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
@@ -69,7 +71,7 @@ DEFAULT_BISECT_FRACTION = 1e-6
 
 
 @register_engine
-class FixedStep(Engine):
+class FixedStep(FrameReadout, FixedStepRun, Engine):
     """Fixed-step simulation with a periodic interference test (PIT).
 
     Args:
@@ -243,55 +245,7 @@ class FixedStep(Engine):
         self._load(state)
         self._broad.load(state.list_positions, state.list_i, state.list_j, built=False)
 
-    def _initial_state(self) -> FixedStepState:
-        discs = self.discs
-        n = len(discs)
-        empty = np.zeros(0, dtype=np.int64)
-        return FixedStepState(
-            time=self.start_time,
-            frame_time=self.start_time,
-            frames=0,
-            **dict.fromkeys(("pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits"), 0),
-            list_builds=0,
-            max_overlap=0.0,
-            virial=0.0,
-            ref_positions=discs.positions,
-            velocities=discs.velocities,
-            ref_times=np.full(n, self.start_time),
-            images=np.zeros((n, 2), dtype=np.int64),
-            frame_positions=discs.positions,
-            list_positions=np.zeros((0, 2)),
-            list_i=empty,
-            list_j=empty,
-        )
-
-    # --- the checkpoint's protocol -------------------------------------------------------
-    def state(self) -> FixedStepState:
-        """The run state (:class:`~discsim.engines.fixed_step.state.FixedStepState`): new arrays."""
-        paths, counts = self._paths, self._tally.counts
-        list_positions, list_i, list_j = self._broad.export()
-        return FixedStepState(
-            time=float(self.time),
-            frame_time=float(self._frame_time),
-            frames=counts["frames"],
-            pair_tests=counts["pair_tests"],
-            segment_tests=counts["segment_tests"],
-            bisection_tests=counts["bisection_tests"],
-            detections=counts["detections"],
-            wall_hits=counts["wall_hits"],
-            list_builds=counts["list_builds"],
-            max_overlap=float(self._tally.max_overlap),
-            virial=float(self._tally.virial),
-            ref_positions=paths.ref_positions.copy(),
-            velocities=paths.velocities.copy(),
-            ref_times=paths.ref_times.copy(),
-            images=paths.images.copy(),
-            frame_positions=paths.frame_positions.copy(),
-            list_positions=list_positions,
-            list_i=list_i,
-            list_j=list_j,
-        )
-
+    # --- the checkpoint's protocol (state() and _load are FixedStepRun's) -----------------
     def _settings(self) -> dict:
         return {
             "record": self.record,
@@ -335,29 +289,6 @@ class FixedStep(Engine):
         if len(events):
             sim._log.extend(events)
         return sim
-
-    def _load(self, state: FixedStepState) -> None:
-        """Put the engine in ``state`` (copied)."""
-        n = len(self.discs)
-        arrays = {}
-        for name, dtype, shape in (
-            ("ref_positions", np.float64, (n, 2)),
-            ("velocities", np.float64, (n, 2)),
-            ("ref_times", np.float64, (n,)),
-            ("images", np.int64, (n, 2)),
-            ("frame_positions", np.float64, (n, 2)),
-        ):
-            array = np.array(getattr(state, name), dtype=dtype)
-            if array.shape != shape:
-                msg = f"FixedStepState.{name} has shape {array.shape}; {shape} expected for {n} discs"
-                raise CheckpointError(msg)
-            arrays[name] = array
-        self._paths = Paths(self.box, **arrays)
-        self._tally = Tally(state.counts, state.max_overlap, state.virial)
-        built = state.list_builds > 0 and len(state.list_positions) == n  # not after add_discs / remove_discs
-        self._broad.load(state.list_positions, state.list_i, state.list_j, built=built)
-        self._frame_time = float(state.frame_time)
-        self.time = float(state.time)
 
     # --- the driver's protocol -----------------------------------------------------------
     def _advance(self, until: float, limit: int | None) -> int:
@@ -522,113 +453,6 @@ class FixedStep(Engine):
             raise
         self._frame_time = self.time = float(times[-1])
         tally.counts["frames"] = k + count
-
-    @property
-    def frames(self) -> int:
-        """Frames done since the start."""
-        return self._tally.counts["frames"]
-
-    @property
-    def counts(self) -> dict[str, int]:
-        """The counters (a fresh dict): see the class docstring."""
-        return dict(self._tally.counts)
-
-    @property
-    def max_overlap(self) -> float:
-        """The deepest disc-disc overlap seen, as a fraction of the contact distance (see the class docstring)."""
-        return self._tally.max_overlap
-
-    @property
-    def positions(self) -> np.ndarray:
-        """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
-        if self.time == self._frame_time:
-            return _readonly(self._paths.frame_positions.copy())
-        return _readonly(self.box.wrap(self._paths.flown(self.time)))
-
-    @property
-    def unwrapped_positions(self) -> np.ndarray:
-        """``(N, 2)`` centres at ``time``, each disc followed across the edges of a periodic box (a fresh copy).
-
-        In a walled box, the same as :attr:`positions`. ``unwrapped_positions - discs.positions`` is each
-        disc's displacement since the start, as a mean-squared displacement needs.
-
-        Example:
-            >>> import discsim as ds
-            >>> sim = ds.FixedStep(ds.Discs([[3.5, 1.0]], [[1.0, 0.0]], 0.5), ds.Box(4.0, 4.0, periodic=True), dt=0.25)
-            >>> sim.run(frames=4).positions.tolist(), sim.unwrapped_positions.tolist()
-            ([[0.5, 1.0]], [[4.5, 1.0]])
-        """
-        if not self.box.periodic:
-            return self.positions
-        return _readonly(self._paths.unwrapped(self.time))
-
-    @property
-    def velocities(self) -> np.ndarray:
-        """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
-        return _readonly(self._paths.velocities.copy())
-
-    def pressure(self) -> float:
-        """Pressure from the virial of the impulses the frames applied, averaged since the start.
-
-        The definition of :meth:`EventDriven.pressure <discsim.engines.event_driven.EventDriven.pressure>`:
-        ``P = (N kT + W / (2 t)) / A`` in 2D, with ``N kT`` the kinetic energy, ``t = time - start_time``,
-        ``A`` the box area and ``W`` the sum over the disc-disc impulses applied of ``dp_i . (r_i - r_j)``
-        (``dp_i`` the momentum disc ``i`` gets, ``r_i - r_j`` the pair's minimum-image separation where the
-        impulse is applied). With walls this is the bulk estimate: wall and segment hits are not counted,
-        as for the event-driven engine. Units: energy per area; ``P A / (N kT)`` is
-        :func:`discsim.compressibility_factor`.
-
-        Where the impulse is applied depends on the policy: at the frame, overlapping (``"resolve"``:
-        ``|r_i - r_j| < sigma``, so ``W`` falls short by the overlap depth at detection, a fraction of order
-        ``v dt / sigma``); at the previous frame (``"revert"``); just touching (``"separate"``); at the
-        contact found inside the frame (``"bisect"``, to ``bisect_tol``; ``"swept"``). Moves without an
-        impulse (``"separate"`` pushing discs apart or back inside a wall, ``"revert"`` sending them back
-        to the previous frame) add nothing: they are not forces, and counting them (``sum m v . dr``) would
-        make ``P`` the virial of the fixed-step dynamics' artefacts rather than an estimate of the hard-disc
-        pressure. As ``dt -> 0`` every policy tends to the event-driven value (``tests/engines/fixed_step/
-        test_pressure.py`` measures the gap at a small step).
-
-        Raises:
-            InvalidArgumentError: if no time has passed since the start, or the run was loaded from a
-                checkpoint written before the fixed-step engine counted its virial whose log does not
-                hold the whole run (the virial of its first part is unknown).
-
-        Example:
-            >>> import discsim as ds
-            >>> discs = ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], radii=1.0)
-            >>> sim = ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=0.25, policy="separate").run(until=4.0)
-            >>> sim.pressure() * 100.0  # (N kT + |dp| sigma / (2 t)) / A with N kT = 1, |dp| = 2, sigma = 2
-            1.5
-        """
-        elapsed = self.time - self.start_time
-        if elapsed <= 0:
-            msg = "pressure() needs a run of positive duration"
-            raise InvalidArgumentError(msg)
-        virial = self._tally.virial
-        if math.isnan(virial):
-            msg = (
-                "pressure() is unknown for this run: it was loaded from a checkpoint written before FixedStep "
-                "counted its collision virial, and that file's event log does not hold the whole run"
-            )
-            raise InvalidArgumentError(msg)
-        return (self.kinetic_energy() + virial / (2.0 * elapsed)) / self.box.area
-
-    def frame_time(self, k):
-        """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""
-        if self._by_rate:
-            return self.start_time + k / self.frame_rate
-        return self.start_time + k * self.dt
-
-    def frame_times(self) -> np.ndarray:
-        """Times ``(frames + 1,)`` of the frames done so far, the start included.
-
-        Example:
-            >>> import discsim as ds
-            >>> sim = ds.FixedStep(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], 0.5), ds.Box(4.0, 2.0), frame_rate=4.0)
-            >>> sim.run(until=0.6).frame_times().tolist(), sim.time
-            ([0.0, 0.25, 0.5], 0.6)
-        """
-        return self.frame_time(np.arange(self.frames + 1))
 
 
 def _choose_backend(backend, policy: str) -> str:

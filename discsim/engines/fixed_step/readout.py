@@ -1,0 +1,144 @@
+"""What a fixed-step run shows: positions and velocities at any time, the counters, the pressure, the frame clock.
+
+:class:`FrameReadout` is the read-only side of :class:`~discsim.engines.fixed_step.engine.FixedStep`: it reads
+the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and changes nothing.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from discsim.engines.fixed_step.arrays import Paths, Tally
+from discsim.errors import InvalidArgumentError
+from discsim.model import Box, _readonly
+
+__all__ = ["FrameReadout"]
+
+
+class FrameReadout:
+    """Positions, velocities, counters, pressure and frame times of a fixed-step run (a mixin of :class:`FixedStep`)."""
+
+    # What the engine provides (declared for readers and the type checker).
+    box: Box
+    time: float
+    start_time: float
+    frame_rate: float
+    dt: float
+    _by_rate: bool
+    _frame_time: float
+    _paths: Paths
+    _tally: Tally
+
+    if TYPE_CHECKING:
+
+        def kinetic_energy(self) -> float: ...  # Engine's
+
+    @property
+    def frames(self) -> int:
+        """Frames done since the start."""
+        return self._tally.counts["frames"]
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """The counters (a fresh dict): see the class docstring."""
+        return dict(self._tally.counts)
+
+    @property
+    def max_overlap(self) -> float:
+        """The deepest disc-disc overlap seen, as a fraction of the contact distance (see the class docstring)."""
+        return self._tally.max_overlap
+
+    @property
+    def positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time`` (a fresh copy; wrapped into a periodic box)."""
+        if self.time == self._frame_time:
+            return _readonly(self._paths.frame_positions.copy())
+        return _readonly(self.box.wrap(self._paths.flown(self.time)))
+
+    @property
+    def unwrapped_positions(self) -> np.ndarray:
+        """``(N, 2)`` centres at ``time``, each disc followed across the edges of a periodic box (a fresh copy).
+
+        In a walled box, the same as :attr:`positions`. ``unwrapped_positions - discs.positions`` is each
+        disc's displacement since the start, as a mean-squared displacement needs.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.FixedStep(ds.Discs([[3.5, 1.0]], [[1.0, 0.0]], 0.5), ds.Box(4.0, 4.0, periodic=True), dt=0.25)
+            >>> sim.run(frames=4).positions.tolist(), sim.unwrapped_positions.tolist()
+            ([[0.5, 1.0]], [[4.5, 1.0]])
+        """
+        if not self.box.periodic:
+            return self.positions
+        return _readonly(self._paths.unwrapped(self.time))
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
+        return _readonly(self._paths.velocities.copy())
+
+    def pressure(self) -> float:
+        """Pressure from the virial of the impulses the frames applied, averaged since the start.
+
+        The definition of :meth:`EventDriven.pressure <discsim.engines.event_driven.EventDriven.pressure>`:
+        ``P = (N kT + W / (2 t)) / A`` in 2D, with ``N kT`` the kinetic energy, ``t = time - start_time``,
+        ``A`` the box area and ``W`` the sum over the disc-disc impulses applied of ``dp_i . (r_i - r_j)``
+        (``dp_i`` the momentum disc ``i`` gets, ``r_i - r_j`` the pair's minimum-image separation where the
+        impulse is applied). With walls this is the bulk estimate: wall and segment hits are not counted,
+        as for the event-driven engine. Units: energy per area; ``P A / (N kT)`` is
+        :func:`discsim.compressibility_factor`.
+
+        Where the impulse is applied depends on the policy: at the frame, overlapping (``"resolve"``:
+        ``|r_i - r_j| < sigma``, so ``W`` falls short by the overlap depth at detection, a fraction of order
+        ``v dt / sigma``); at the previous frame (``"revert"``); just touching (``"separate"``); at the
+        contact found inside the frame (``"bisect"``, to ``bisect_tol``; ``"swept"``). Moves without an
+        impulse (``"separate"`` pushing discs apart or back inside a wall, ``"revert"`` sending them back
+        to the previous frame) add nothing: they are not forces, and counting them (``sum m v . dr``) would
+        make ``P`` the virial of the fixed-step dynamics' artefacts rather than an estimate of the hard-disc
+        pressure. As ``dt -> 0`` every policy tends to the event-driven value (``tests/engines/fixed_step/
+        test_pressure.py`` measures the gap at a small step).
+
+        Raises:
+            InvalidArgumentError: if no time has passed since the start, or the run was loaded from a
+                checkpoint written before the fixed-step engine counted its virial whose log does not
+                hold the whole run (the virial of its first part is unknown).
+
+        Example:
+            >>> import discsim as ds
+            >>> discs = ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], radii=1.0)
+            >>> sim = ds.FixedStep(discs, ds.Box(10.0, 10.0), dt=0.25, policy="separate").run(until=4.0)
+            >>> sim.pressure() * 100.0  # (N kT + |dp| sigma / (2 t)) / A with N kT = 1, |dp| = 2, sigma = 2
+            1.5
+        """
+        elapsed = self.time - self.start_time
+        if elapsed <= 0:
+            msg = "pressure() needs a run of positive duration"
+            raise InvalidArgumentError(msg)
+        virial = self._tally.virial
+        if math.isnan(virial):
+            msg = (
+                "pressure() is unknown for this run: it was loaded from a checkpoint written before FixedStep "
+                "counted its collision virial, and that file's event log does not hold the whole run"
+            )
+            raise InvalidArgumentError(msg)
+        return (self.kinetic_energy() + virial / (2.0 * elapsed)) / self.box.area
+
+    def frame_time(self, k):
+        """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""
+        if self._by_rate:
+            return self.start_time + k / self.frame_rate
+        return self.start_time + k * self.dt
+
+    def frame_times(self) -> np.ndarray:
+        """Times ``(frames + 1,)`` of the frames done so far, the start included.
+
+        Example:
+            >>> import discsim as ds
+            >>> sim = ds.FixedStep(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], 0.5), ds.Box(4.0, 2.0), frame_rate=4.0)
+            >>> sim.run(until=0.6).frame_times().tolist(), sim.time
+            ([0.0, 0.25, 0.5], 0.6)
+        """
+        return self.frame_time(np.arange(self.frames + 1))

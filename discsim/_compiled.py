@@ -17,7 +17,7 @@ from typing import Any, cast
 
 from discsim._numba import numba
 
-__all__ = ["compile_from_source", "inline", "jit", "prefetch"]
+__all__ = ["compile_from_source", "inline", "interpret", "jit", "prefetch"]
 
 #: What every compiled function of discsim may compile into itself, besides its own folder's modules (the
 #: physics parts, the minimum image, the queue's heap, the event kinds, this module): paths under the package.
@@ -136,6 +136,12 @@ else:
         return types.void(array, offset), codegen
 
 
+def interpret(function):
+    """A ``decorate`` for :func:`compile_from_source` that compiles nothing: the functions are only rebuilt over
+    their replacements, and run in the interpreter (the pure-Python backend's loop over other physics)."""
+    return function
+
+
 def compile_from_source(
     functions: Iterable[Callable[..., Any]],
     decorate: Callable[[FunctionType], Callable[..., Any]],
@@ -157,12 +163,13 @@ def compile_from_source(
         replace: a dict from listed functions to the functions that stand in for them (None: none).
 
     Returns:
-        A dict from each given function to its compiled version (to itself, or its replacement, without
-        numba: then nothing is compiled and the callers keep their own globals).
+        A dict from each given function to its compiled version (without numba, or with ``decorate``
+        :func:`interpret`, the function rebuilt over the replacements but not compiled; with neither numba
+        nor replacements, the function itself).
     """
     replace = replace or {}
-    if _nb is None:
-        return {function: replace.get(function, function) for function in functions}
+    if _nb is None and not replace:
+        return {function: function for function in functions}
     compiled: dict[Callable[..., Any], Callable[..., Any]] = {}
     for function in functions:
         source = cast(FunctionType, replace.get(function, function))  # plain Python functions, as documented

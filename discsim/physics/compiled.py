@@ -12,7 +12,7 @@ numba the names are the plain Python functions.
 from __future__ import annotations
 
 from discsim import model
-from discsim._compiled import compile_from_source, jit
+from discsim._compiled import compile_from_source, interpret, jit
 from discsim._numba import numba
 from discsim.physics import dynamics, laws
 from discsim.physics.sources import boundaries, pairs
@@ -69,7 +69,7 @@ _NAMES = {
 }
 
 
-def compile_parts(law_of_motion=None, collision_law=None) -> dict:
+def compile_parts(law_of_motion=None, collision_law=None, *, interpreted: bool = False) -> dict:
     """Every part compiled (``jit``), over another law of motion or collision law if given.
 
     Args:
@@ -77,6 +77,7 @@ def compile_parts(law_of_motion=None, collision_law=None) -> dict:
             signatures of :mod:`discsim.physics.dynamics`; None: free flight.
         collision_law: likewise with the functions :data:`LAWS` names (:mod:`discsim.physics.laws`); None:
             elastic and frictionless.
+        interpreted: rebuild the parts over the laws but compile nothing (they run in the interpreter).
 
     Returns:
         A dict from the names the compiled loops use (``advance``, ``pair_predict``, ``predict_x`` ...) to the
@@ -87,9 +88,9 @@ def compile_parts(law_of_motion=None, collision_law=None) -> dict:
         replace.update({getattr(dynamics, name): getattr(law_of_motion, name) for name in DYNAMICS})
     if collision_law is not None:
         replace.update({getattr(laws, name): getattr(collision_law, name) for name in LAWS})
-    decorate = jit
+    decorate = interpret if interpreted else jit
     nb = numba()
-    if replace and nb is not None:
+    if replace and nb is not None and not interpreted:
         # Not cached on disk: numba would file these under the very names of the free-flight parts (its cache
         # knows a function by its source file and name, not by the parts compiled into it).
         decorate = nb.njit(cache=False, nogil=True, error_model="numpy", _nrt=False)

@@ -22,7 +22,7 @@ from discsim.events import EventLog
 from discsim.physics import dynamics
 from discsim.scene import Scene
 
-pytestmark = pytest.mark.skipif(not available(), reason="the compiled loop needs numba")
+needs_numba = pytest.mark.skipif(not available(), reason="the compiled loop needs numba")
 
 WIND = 0.75  # length / time, along x
 
@@ -55,14 +55,17 @@ wind = SimpleNamespace(
 # --8<-- [end:law]
 
 
-def _run(discs, box, events, law_of_motion=None, collision_law=None, segments=()):
-    """The compiled loop over the given laws, its first ``events`` physical events: the backend and its log."""
+def _run(discs, box, events, law_of_motion=None, collision_law=None, segments=(), interpreted=False):
+    """The compiled loop over the given laws (or the same loop interpreted), its first ``events`` physical events:
+    the backend and its log."""
     from discsim.engines.event_driven.engine import EventDriven
     from discsim.engines.event_driven.numba.backend import NumbaBackend
 
     scene = Scene(discs, box, segments)
     grid = EventDriven.cell_grid(discs.radii, box)
-    backend = NumbaBackend(scene, grid, "calendar", law_of_motion=law_of_motion, collision_law=collision_law)
+    backend = NumbaBackend(
+        scene, grid, "calendar", law_of_motion=law_of_motion, collision_law=collision_law, interpreted=interpreted
+    )
     backend.start()
     log = EventLog()
     backend.advance(math.inf, events, log)
@@ -80,6 +83,7 @@ def _by_pair(log):
 
 
 @pytest.mark.slow  # compiles the event loop anew (about a minute on 2 cores)
+@needs_numba
 def test_a_gas_in_a_wind_is_the_same_gas_seen_from_a_moving_frame():
     discs, box = ds.random_gas(300, 0.35, periodic=True, seed=4)
     boosted = discs.replace(velocities=discs.velocities + np.array([WIND, 0.0]))
@@ -103,6 +107,7 @@ def test_a_gas_in_a_wind_is_the_same_gas_seen_from_a_moving_frame():
     np.testing.assert_allclose(windy.positions(), still.positions(), atol=1e-8)
 
 
+@needs_numba
 def test_every_function_that_reaches_a_part_is_rebuilt():
     # with_physics swaps parts by name in the functions of PHYSICAL: a function of the loop that calls a part,
     # itself or through another function, and is not in that list would keep free flight.
@@ -125,6 +130,7 @@ def test_every_function_that_reaches_a_part_is_rebuilt():
 
 
 @pytest.mark.slow  # compiles the event loop anew (once for the three scenes)
+@needs_numba
 def test_the_loop_compiled_over_free_flight_and_the_elastic_law_is_the_usual_loop_bit_for_bit():
     # with_physics over the free-flight and elastic modules themselves: the same events, to the last bit, in a
     # walled box with segments, in a periodic box (crossings through the edges, the minimum image), and after a
@@ -153,6 +159,7 @@ def test_the_loop_compiled_over_free_flight_and_the_elastic_law_is_the_usual_loo
 
 
 @pytest.mark.slow  # compiles the event loop anew
+@needs_numba
 def test_a_law_in_which_no_pair_ever_meets_gives_no_collision():
     # Every part the loop calls comes from the law: discs that never meet (a toy pair time of impact) only
     # cross cells and hit walls.
@@ -167,3 +174,45 @@ def test_a_law_in_which_no_pair_ever_meets_gives_no_collision():
 def _never(dx, dy, dvx, dvy, sigma):
     """A pair time of impact for discs that pass through each other."""
     return math.inf
+
+
+def test_the_interpreted_loop_over_free_flight_is_the_pure_python_backend_bit_for_bit():
+    # The loop the compiled backend compiles, run by the interpreter (no numba needed): with free flight and the
+    # elastic law, the pure-Python backend's events to the last bit, in a walled box and a periodic one.
+    from discsim.engines.event_driven.python import PythonBackend
+
+    for periodic, seed in ((False, 5), (True, 6)):
+        discs, box = ds.random_gas(120, 0.4, periodic=periodic, seed=seed)
+        interpreted, log = _run(discs, box, 600, interpreted=True)
+        assert interpreted.name == "python"
+        scene = Scene(discs, box)
+        from discsim.engines.event_driven.engine import EventDriven
+
+        usual = PythonBackend(scene, EventDriven.cell_grid(discs.radii, box), "calendar")
+        usual.start()
+        reference = EventLog()
+        usual.advance(math.inf, 600, reference)
+        assert log.tobytes() == reference.to_array().tobytes()
+        assert interpreted.positions().tobytes() == usual.positions().tobytes()
+
+
+def test_the_interpreted_loop_runs_a_new_law_as_the_compiled_one_would():
+    # The wind law in the interpreter: the Galilean check of the compiled test above, with no numba needed.
+    discs, box = ds.random_gas(150, 0.35, periodic=True, seed=4)
+    boosted = discs.replace(velocities=discs.velocities + np.array([WIND, 0.0]))
+    windy, log = _run(discs, box, 400, law_of_motion=wind, interpreted=True)
+    still, reference = _run(boosted, box, 400, interpreted=True)
+    log, reference = _by_pair(log), _by_pair(reference)
+    np.testing.assert_array_equal(log["i"], reference["i"])
+    np.testing.assert_allclose(log["time"], reference["time"], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(log["vxi"] + WIND, reference["vxi"], atol=1e-8)
+    np.testing.assert_allclose(windy.positions(), still.positions(), atol=1e-8)
+
+
+@needs_numba
+@pytest.mark.slow  # compiles the event loop anew
+def test_the_interpreted_loop_gives_the_compiled_loops_events_bit_for_bit_under_a_new_law():
+    discs, box = ds.random_gas(150, 0.35, periodic=True, seed=8)
+    _, compiled = _run(discs, box, 400, law_of_motion=wind)
+    _, interpreted = _run(discs, box, 400, law_of_motion=wind, interpreted=True)
+    assert compiled.tobytes() == interpreted.tobytes()

@@ -53,11 +53,16 @@ class NumbaBackend:
             :mod:`discsim.physics.dynamics` and :mod:`discsim.physics.laws`; None: free flight and the elastic
             law), compiled into it by :func:`~discsim.engines.event_driven.numba.loop.with_physics`. No engine
             passes them yet: ``docs/adding-physics.md`` shows a test that does.
+        interpreted: run the same loop in the interpreter, compiled by nothing (``name`` is then
+            ``"python"``): how the pure-Python backend runs a law of motion or a collision law its own loop
+            does not inline; it needs no numba, and gives the compiled loop's events bit for bit.
     """
 
     name = "numba"
 
-    def __init__(self, scene: Scene, grid: CellGrid, queue: str, law_of_motion=None, collision_law=None):
+    def __init__(
+        self, scene: Scene, grid: CellGrid, queue: str, law_of_motion=None, collision_law=None, *, interpreted=False
+    ):
         self.scene = scene
         self.box = scene.box
         self.grid = grid
@@ -65,8 +70,10 @@ class NumbaBackend:
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
         self._lp = _loop()
         self._law_of_motion = law_of_motion or dynamics
-        if law_of_motion is not None or collision_law is not None:
-            self._lp = SimpleNamespace(**self._lp.with_physics(law_of_motion, collision_law))
+        if law_of_motion is not None or collision_law is not None or interpreted:
+            self._lp = SimpleNamespace(**self._lp.with_physics(law_of_motion, collision_law, interpreted=interpreted))
+        if interpreted:
+            self.name = "python"
         box = self.box
         nx, ny = grid.nx, grid.ny
         # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides

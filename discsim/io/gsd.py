@@ -26,6 +26,7 @@ import numpy as np
 
 from discsim.analysis.frames import Frames
 from discsim.errors import InvalidArgumentError
+from discsim.io.container import replacing
 from discsim.model import Box, image_steps
 
 __all__ = ["append_frames", "open_gsd", "read_gsd", "require_gsd", "write_gsd"]
@@ -131,7 +132,8 @@ def write_gsd(path, source, times=None) -> Path:
     """
     frames = _as_frames(source, times)
     path = Path(path)
-    with open_gsd(path, "w") as handle:
+    require_gsd()
+    with replacing(path) as tmp, open_gsd(tmp, "w") as handle:
         append_frames(handle, frames)
     return path
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from discsim.analysis.frames import Frames
 from discsim.errors import InvalidArgumentError
+from discsim.io.container import replacing
 from discsim.model import Box
 
 __all__ = ["read_xyz", "write_xyz"]
@@ -87,7 +88,8 @@ def write_xyz(path, source, times=None) -> Path:
                 f"{masses[d]!r} {groups[d]}"
             )
     path = Path(path)
-    path.write_text("\n".join(lines) + "\n")
+    with replacing(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
     return path
 
 

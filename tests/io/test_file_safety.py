@@ -79,3 +79,100 @@ def test_an_exception_midway_through_write_gsd_leaves_the_old_file(tmp_path, mon
         ds.write_gsd(path, _frames(8))
     assert path.read_bytes() == old
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.gsd"]
+
+
+# --- item 4: every read returns what was written or names what is wrong -------------------------
+def _same(a: ds.Frames, b: ds.Frames) -> bool:
+    fields = ("times", "positions", "unwrapped", "velocities", "radii", "masses", "groups")
+    return a.box == b.box and all(np.array_equal(getattr(a, f), getattr(b, f)) for f in fields)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_single_bit_flips_read_back_equal_or_raise_a_discsim_error(tmp_path, kind):
+    path, damaged = tmp_path / f"good.{kind}", tmp_path / f"damaged.{kind}"
+    _write(kind, path, _frames())
+    data, written = path.read_bytes(), _read(kind, path)
+    rng = np.random.default_rng(30)
+    outcomes = {"equal": 0, "refused": 0}
+    for bit in rng.integers(0, 8 * len(data), size=300).tolist():
+        flipped = bytearray(data)
+        flipped[bit // 8] ^= 1 << (bit % 8)
+        damaged.write_bytes(bytes(flipped))
+        try:
+            back = _read(kind, damaged)
+        except ds.DiscsimError as exc:
+            assert str(damaged) in str(exc)
+            outcomes["refused"] += 1
+        else:
+            assert _same(back, written), f"bit {bit} (byte {bit // 8}) reads back changed, silently"
+            outcomes["equal"] += 1
+    assert outcomes["refused"] > 50  # the flips land in the data, and are found
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_a_file_without_discs_reads_back(tmp_path, kind):
+    frames = _frames(0)
+    back = _read(kind, _write(kind, tmp_path / f"empty.{kind}", frames))
+    assert _same(back, frames) and back.positions.shape == (3, 0, 2)
+
+
+def test_an_xyz_file_edited_by_hand_is_refused_by_its_checksum(tmp_path):
+    path = ds.write_xyz(tmp_path / "run.xyz", _frames())
+    lines = path.read_text().splitlines()
+    row = lines[3].split()
+    row[1] = repr(float(row[1]) + 1e-9)
+    lines[3] = " ".join(row)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ds.InvalidArgumentError, match=r"frame 0 \(from line 1\) does not match its checksum"):
+        ds.read_xyz(path)
+    lines[1] = lines[1][: lines[1].index(" discsim_sha256=")]  # no checksum: taken as another tool's file
+    path.write_text("\n".join(lines) + "\n")
+    assert ds.read_xyz(path).positions[0, 1, 0] == float(row[1])
+
+
+def test_garbage_in_an_xyz_file_is_named(tmp_path):
+    path = ds.write_xyz(tmp_path / "run.xyz", _frames())
+    good = path.read_bytes()
+    path.write_bytes(good + b"\x00\xff\xfe binary tail")
+    with pytest.raises(ds.InvalidArgumentError, match=rf"{path.name} is not a text file .*byte {len(good) + 1}"):
+        ds.read_xyz(path)
+    path.write_bytes(good + b"some trailing words\n")
+    with pytest.raises(ds.InvalidArgumentError, match="should count the discs of frame 3"):
+        ds.read_xyz(path)
+    path.write_bytes(good.replace(b"Time=0.5", b"Time=0.5x", 1))
+    with pytest.raises(ds.InvalidArgumentError, match="frame 1 .*does not match its checksum"):
+        ds.read_xyz(path)
+
+
+@needs_gsd
+def test_a_gsd_file_given_to_read_xyz_is_named(tmp_path):
+    path = ds.write_gsd(tmp_path / "run.gsd", _frames())
+    with pytest.raises(ds.InvalidArgumentError, match="run.gsd is not a text file"):
+        ds.read_xyz(path)
+
+
+@needs_gsd
+def test_a_huge_size_in_a_gsd_index_is_refused_before_allocating(tmp_path):
+    path = ds.write_gsd(tmp_path / "run.gsd", _frames())
+    data = bytearray(path.read_bytes())
+    index_at = int.from_bytes(data[8:16], "little")
+    data[index_at + 8 : index_at + 16] = (1 << 50).to_bytes(8, "little")  # the first chunk's N: 2^50 rows
+    path.write_bytes(bytes(data))
+    with pytest.raises(ds.InvalidArgumentError, match=r"run.gsd is damaged: an index entry .* 1125899906842624 x"):
+        ds.read_gsd(path)
+
+
+@needs_gsd
+def test_a_gsd_frame_changed_in_place_is_refused_by_its_checksum(tmp_path):
+    import gsd.fl
+
+    path = ds.write_gsd(tmp_path / "run.gsd", _frames())
+    with gsd.fl.open(str(path), "r") as handle:
+        position = handle.read_chunk(frame=1, name="particles/position")
+    data = path.read_bytes()
+    at = data.index(position.tobytes())
+    changed = position.copy()
+    changed[2, 0] += 0.25  # a plausible value: nothing but the checksum can tell
+    path.write_bytes(data[:at] + changed.tobytes() + data[at + changed.nbytes :])
+    with pytest.raises(ds.InvalidArgumentError, match="frame 1 does not match its checksum"):
+        ds.read_gsd(path)

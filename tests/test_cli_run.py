@@ -261,3 +261,40 @@ def test_longrun_benchmark_quick(tmp_path):
     assert np.all(np.diff([int(row["collisions"]) for row in dense]) > 0)
     assert (tmp_path / "longrun.png").stat().st_size > 0
     assert "bytes/event" in done.stdout
+
+
+def _cut_run_folder(folder: Path) -> tuple[Path, list[tuple[int, int]]]:
+    """A run folder (as `discsim run` writes) whose log holds chunks of 100 events; ``(end offset, events before
+    it)`` after the header and after each chunk."""
+    folder.mkdir()
+    sim = ds.EventDriven(*ds.random_gas(60, 0.4, seed=5), record=False)
+    sim.stream_chunk = 100
+    log = folder / RUN_FILES["events"]
+    sim.run(until=6.0, record_to=log, checkpoint=folder / RUN_FILES["checkpoint"], checkpoint_every=10**6)
+    walk = list(ds.io.container.iter_stream(log))
+    return log, [(end, sum(len(w[2]) for w in walk[: k + 1])) for k, (*_, end) in enumerate(walk)]
+
+
+def test_view_of_a_run_folder_whose_log_was_cut_says_where_it_stops(tmp_path, capsys):
+    log, ends = _cut_run_folder(tmp_path / "run")
+    first = next(k for k, (_, events) in enumerate(ends) if events)  # the first chunk that holds events
+    data = log.read_bytes()
+    log.write_bytes(data[: (ends[first - 1][0] + ends[first][0]) // 2])  # cut inside it
+    assert main(["view", str(tmp_path / "run")]) == 1
+    err = capsys.readouterr().err
+    assert "recorded nothing" not in err
+    saw = ds.checkpoint_info(tmp_path / "run" / RUN_FILES["checkpoint"])["stream"]["records"]
+    assert f"events.dse stops at byte {ends[first - 1][0]:,} (" in err and f"the checkpoint saw {saw:,})" in err
+    assert "whole chunks hold 0 events" in err and "nothing to replay" in err
+    assert not (tmp_path / "run" / "view.html").exists()
+    end, events = ends[first + 2]
+    assert events == 300 < saw
+    log.write_bytes(data[: end + 10])  # three chunks of events, then a cut
+    assert ds.io.container.stream_extent(log)[:2] == (end, 300)
+    assert main(["view", str(tmp_path / "run")]) == 0
+    captured = capsys.readouterr()
+    assert "300 events" in captured.out
+    assert f"note: {log} stops at byte {end:,}" in captured.err and "whole chunks hold 300 events" in captured.err
+    log.write_bytes(data)
+    assert main(["view", str(tmp_path / "run")]) == 0
+    assert "note" not in capsys.readouterr().err

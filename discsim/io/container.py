@@ -56,6 +56,7 @@ __all__ = [
     "read_state",
     "read_stream",
     "replacing",
+    "stream_extent",
     "write_state",
 ]
 
@@ -411,6 +412,48 @@ def read_stream(path, *, partial: bool = False) -> RecordStream:
         pieces.append(records)
     records = np.concatenate(pieces)
     return RecordStream(meta, arrays, records, len(pieces) - 1, end, last)
+
+
+def stream_extent(path) -> tuple[int, int, dict]:
+    """How far a record stream's whole blocks reach, read from their lengths and each chunk's JSON only.
+
+    No records are read and no checksum is checked, so this is cheap on a log of any size: use it to say where
+    a file cut short (or damaged) stops; :func:`iter_stream` verifies.
+
+    Returns:
+        ``(end, records, last)``: the byte after the last whole block (the file's size when none is cut), the
+        records in the whole chunks, and the JSON dict of the last whole chunk (empty when there is none).
+
+    Raises:
+        FileNotFoundError: if there is no such file.
+    """
+    path = Path(path)
+    size = path.stat().st_size
+    end, records, last = 0, 0, {}
+    with open(path, "rb") as handle:
+        if len(handle.read(_PREFIX.size)) < _PREFIX.size:
+            return end, records, last
+        end = _PREFIX.size
+        header = True
+        while end + _LENGTH.size <= size:
+            handle.seek(end)
+            (body_len,) = _LENGTH.unpack(handle.read(_LENGTH.size))
+            block_end = end + _LENGTH.size + body_len + _DIGEST
+            if block_end > size:
+                break
+            if not header:
+                raw = handle.read(min(body_len, _LENGTH.size))
+                json_len = _LENGTH.unpack(raw)[0] if len(raw) == _LENGTH.size else body_len
+                if json_len > min(body_len - _LENGTH.size, _MAX_JSON):
+                    break
+                try:
+                    meta = json.loads(handle.read(json_len).decode("utf-8"))["meta"]
+                    count = int(meta["count"])
+                except (ValueError, KeyError, TypeError):
+                    break
+                records, last = records + count, meta
+            header, end = False, block_end
+    return end, records, last
 
 
 def _verify_chunks(handle, path: Path, dtype: np.dtype, position: int, end: int, records: int) -> None:

@@ -176,3 +176,20 @@ def test_a_gsd_frame_changed_in_place_is_refused_by_its_checksum(tmp_path):
     path.write_bytes(data[:at] + changed.tobytes() + data[at + changed.nbytes :])
     with pytest.raises(ds.InvalidArgumentError, match="frame 1 does not match its checksum"):
         ds.read_gsd(path)
+
+
+@pytest.mark.parametrize("kind", ["checkpoint", "events"])
+def test_single_bit_flips_of_a_checkpoint_or_event_log_are_refused(tmp_path, kind):
+    """The container files were already safe (a SHA-256 per block); this keeps them so, beside GSD and XYZ."""
+    sim = ds.EventDriven(*ds.random_gas(6, 0.2, seed=4), record=False)
+    sim.run(until=2.0, record_to=tmp_path / "events.dse", checkpoint=tmp_path / "state.dsc")
+    path = tmp_path / ("state.dsc" if kind == "checkpoint" else "events.dse")
+    read = ds.load if kind == "checkpoint" else ds.read_events
+    data, damaged = path.read_bytes(), tmp_path / f"damaged{path.suffix}"
+    rng = np.random.default_rng(31)
+    for bit in rng.integers(0, 8 * len(data), size=300).tolist():
+        flipped = bytearray(data)
+        flipped[bit // 8] ^= 1 << (bit % 8)
+        damaged.write_bytes(bytes(flipped))
+        with pytest.raises(ds.DiscsimError, match=str(damaged)):
+            read(damaged)

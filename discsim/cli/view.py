@@ -82,7 +82,8 @@ def where_log_stops(source: str) -> tuple[str, int] | None:
     from discsim.io.container import STATE_MAGIC, stream_extent
 
     path = Path(source)
-    log, checkpoint = path, None
+    log: Path | None = path
+    checkpoint: Path | None = None
     if path.is_dir():
         log, checkpoint = path / RUN_FILES["events"], path / RUN_FILES["checkpoint"]
     elif path.is_file():

@@ -429,7 +429,8 @@ def stream_extent(path) -> tuple[int, int, dict]:
     """
     path = Path(path)
     size = path.stat().st_size
-    end, records, last = 0, 0, {}
+    end, records = 0, 0
+    last: dict = {}
     with open(path, "rb") as handle:
         if len(handle.read(_PREFIX.size)) < _PREFIX.size:
             return end, records, last

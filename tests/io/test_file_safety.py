@@ -4,7 +4,7 @@ it was, and every read returns exactly what was written or raises a DiscsimError
 from __future__ import annotations
 
 import contextlib
-import importlib.util
+import importlib
 import resource
 import signal
 
@@ -14,7 +14,16 @@ import pytest
 import discsim as ds
 import discsim.io.gsd as gsd_module
 
-needs_gsd = pytest.mark.skipif(importlib.util.find_spec("gsd") is None, reason="the gsd package (io extra)")
+
+def _have_gsd() -> bool:
+    try:
+        importlib.import_module("gsd.hoomd")
+    except ImportError:
+        return False
+    return True
+
+
+needs_gsd = pytest.mark.skipif(not _have_gsd(), reason="needs the gsd package (the io extra)")
 
 
 def _frames(n: int = 6, times=(0.0, 0.5, 1.0)) -> ds.Frames:

@@ -189,8 +189,9 @@ def read_gsd(path) -> Frames:
         FileNotFoundError: if there is no such file.
         InvalidArgumentError: naming the file, if it is not a GSD file of HOOMD's schema, holds no frame, holds
             3D data (``dimensions = 3`` or a nonzero z), a tilted box, or frames whose number of discs changes;
-            or if it is damaged: an index that points past its end, a frame that does not match the checksum
-            discsim wrote with it, chunks gsd cannot read.
+            or if it is damaged: an index that points past its end, a number of particles that frame 0's
+            positions do not bear out, a frame that does not match the checksum discsim wrote with it, chunks
+            gsd cannot read.
     """
     hoomd = require_gsd()
     path = Path(path)
@@ -201,6 +202,8 @@ def read_gsd(path) -> Frames:
     try:
         _check_counts(path)
         handle = hoomd.open(str(path), "r")
+    except DiscsimError:
+        raise
     except Exception as exc:  # gsd raises RuntimeError, OSError or ValueError on a foreign file
         msg = f"{path} is not a GSD file of HOOMD's schema ({type(exc).__name__}: {exc})"
         raise InvalidArgumentError(msg) from exc

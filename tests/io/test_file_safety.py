@@ -202,3 +202,21 @@ def test_single_bit_flips_of_a_checkpoint_or_event_log_are_refused(tmp_path, kin
         damaged.write_bytes(bytes(flipped))
         with pytest.raises(ds.DiscsimError, match=str(damaged)):
             read(damaged)
+
+
+@needs_gsd
+def test_a_huge_number_of_particles_in_a_gsd_file_is_refused_before_allocating(tmp_path):
+    path = ds.write_gsd(tmp_path / "run.gsd", _frames())
+    data = path.read_bytes()
+    index_at = int.from_bytes(data[8:16], "little")
+    entry = [("frame", "<u8"), ("N", "<u8"), ("location", "<i8"), ("M", "<u4"), ("id", "<u2"), ("type", "u1")]
+    index = np.frombuffer(data, dtype=np.dtype([*entry, ("flags", "u1")]), count=20, offset=index_at)  # gsd.h
+    uint32_scalars = index[(index["frame"] == 0) & (index["type"] == 3) & (index["N"] == 1)]
+    at = int(uint32_scalars["location"][0])  # frame 0's only uint32 scalar: particles/N
+    assert int.from_bytes(data[at : at + 4], "little") == 6
+    huge = (6 + 2**25).to_bytes(4, "little")  # gsd would fill 33 million default rows per array
+    path.write_bytes(data[:at] + huge + data[at + 4 :])
+    with pytest.raises(
+        ds.InvalidArgumentError, match="frame 0 declares 33554438 particles but holds the positions of 6"
+    ):
+        ds.read_gsd(path)

@@ -298,3 +298,13 @@ def test_view_of_a_run_folder_whose_log_was_cut_says_where_it_stops(tmp_path, ca
     log.write_bytes(data)
     assert main(["view", str(tmp_path / "run")]) == 0
     assert "note" not in capsys.readouterr().err
+
+
+def test_ctrl_c_while_placing_the_discs_leaves_nothing_and_says_so(tmp_path, capsys, monkeypatch):
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ds, "random_gas", interrupted)
+    assert main(_args(tmp_path / "run", 3.0, 0.3, 100)) == 130
+    assert "interrupted before anything was written; run the same command again" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())

@@ -192,7 +192,12 @@ def handle(args: argparse.Namespace) -> int:
         print(f"discsim run: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"\ndiscsim run: interrupted; continue with the same command and --resume (from {out})", file=sys.stderr)
+        if not files["run"].exists():  # stopped while placing the discs: nothing was written, nothing to resume
+            print("\ndiscsim run: interrupted before anything was written; run the same command again", file=sys.stderr)
+        else:
+            print(
+                f"\ndiscsim run: interrupted; continue with the same command and --resume (from {out})", file=sys.stderr
+            )
         return 130
     except OSError as exc:  # a full disk, say: the last checkpoint is whole (files are replaced atomically)
         print(f"discsim run: {os_problem(exc, out)}", file=sys.stderr)

@@ -16,6 +16,7 @@ import pytest
 from paths import ROOT
 
 import discsim as ds
+from discsim import _numba
 from discsim.cli import RUN_FILES, main
 
 
@@ -106,12 +107,89 @@ def test_run_resume_extends_a_run_exactly(tmp_path):
     assert 0 < summary["session_collisions"] < summary["collisions"]
 
 
-def test_run_with_walls_and_resume_into_an_empty_folder(tmp_path, capsys):
+def test_run_with_walls(tmp_path, capsys):
     out = tmp_path / "walls"
-    assert main(_args(out, 3.0, 0.3, 100, "--walls", "--resume")) == 0  # nothing to resume: starts
+    assert main(_args(out, 3.0, 0.3, 100, "--walls")) == 0
     assert "box with walls" in capsys.readouterr().out
     summary = json.loads((out / RUN_FILES["summary"]).read_text())
     assert summary["periodic"] is False and summary["wall_hits"] > 0
+
+
+def test_resume_with_no_run_in_the_folder_is_refused_and_creates_nothing(tmp_path, capsys):
+    empty, missing = tmp_path / "empty", tmp_path / "missing" / "run"
+    empty.mkdir()
+    assert main(_args(empty, 3.0, 0.3, 100, "--resume")) == 1
+    assert f"nothing to resume: {empty} is empty" in capsys.readouterr().err
+    assert main(_args(missing, 3.0, 0.3, 100, "--resume")) == 1
+    assert f"nothing to resume: {missing} does not exist" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == [empty] and not list(empty.iterdir())
+
+
+def test_a_refused_gas_leaves_no_output_folder(tmp_path, capsys):
+    out = tmp_path / "new" / "run"
+    assert main(_args(out, 3.0, 0.9, 100)) == 1
+    assert "packing fraction 0.9 cannot be reached" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_resuming_a_copied_folder_whose_log_was_deleted_is_refused(tmp_path, capsys):
+    import shutil
+
+    assert main(_args(tmp_path / "a", until=3.0)) == 0
+    copy = tmp_path / "copy"
+    shutil.copytree(tmp_path / "a", copy)
+    (copy / RUN_FILES["events"]).unlink()
+    before = _snapshot(copy)
+    assert main(_args(copy, 6.0, 0.4, 150, "--resume")) == 1
+    err = capsys.readouterr().err
+    records = ds.checkpoint_info(copy / RUN_FILES["checkpoint"])["stream"]["records"]
+    assert f"{copy / RUN_FILES['events']} is missing, but the checkpoint saw {records:,} events" in err
+    assert _snapshot(copy) == before
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "expected"),
+    [
+        ("--seed", "-3", "expected an integer, 0 or more, got '-3'"),
+        ("--since", "nan", "expected a finite number, 0 or more, got 'nan'"),
+        ("--since", "-1", "expected a finite number, 0 or more, got '-1'"),
+        ("--since", "inf", "expected a finite number, 0 or more, got 'inf'"),
+    ],
+)
+def test_a_negative_seed_or_since_is_a_usage_error(tmp_path, capsys, option, value, expected):
+    args = _args(tmp_path / "run", 3.0, 0.3, 100)
+    args += [option, value] if option not in args else []
+    args[args.index(option) + 1] = value
+    with pytest.raises(SystemExit) as exit_info:
+        main(args)
+    assert exit_info.value.code == 2 and expected in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_since_after_until_is_refused_before_anything_runs(tmp_path, capsys):
+    assert main(_args(tmp_path / "run", 3.0, 0.3, 100, "--since", "3.5")) == 2
+    assert "--since 3.5 must lie before --until 3" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+    assert main(_args(tmp_path / "run", 3.0, 0.3, 100, "--since", "1")) == 0
+    summary = json.loads((tmp_path / "run" / RUN_FILES["summary"]).read_text())
+    assert summary["since"] == 1.0 and np.isfinite([summary["Z"], summary["Z_err"]]).all()
+
+
+@pytest.mark.parametrize("backend", ["python", "numba"])
+def test_backend_option_runs_and_resumes_under_the_backend_asked(tmp_path, capsys, backend):
+    if backend == "numba" and not _numba.available():
+        pytest.skip("numba is not installed or is hidden (the fast extra)")
+    other = "numba" if backend == "python" and _numba.available() else "python"
+    assert main(_args(tmp_path / "a", 4.0, 0.4, 150, "--backend", backend)) == 0
+    assert f"{backend} backend" in capsys.readouterr().out
+    assert json.loads((tmp_path / "a" / RUN_FILES["summary"]).read_text())["backend"] == backend
+    assert main(_args(tmp_path / "a", 9.0, 0.4, 150, "--resume", "--backend", other)) == 0
+    assert json.loads((tmp_path / "a" / RUN_FILES["summary"]).read_text())["backend"] == other
+    assert main(_args(tmp_path / "b", until=9.0)) == 0  # auto
+    assert json.loads((tmp_path / "b" / RUN_FILES["summary"]).read_text())["backend"] == (
+        "numba" if _numba.available() else "python"
+    )
+    _assert_same_run(tmp_path / "a", tmp_path / "b")
 
 
 def test_usage_errors_exit_with_2(capsys):
@@ -183,3 +261,50 @@ def test_longrun_benchmark_quick(tmp_path):
     assert np.all(np.diff([int(row["collisions"]) for row in dense]) > 0)
     assert (tmp_path / "longrun.png").stat().st_size > 0
     assert "bytes/event" in done.stdout
+
+
+def _cut_run_folder(folder: Path) -> tuple[Path, list[tuple[int, int]]]:
+    """A run folder (as `discsim run` writes) whose log holds chunks of 100 events; ``(end offset, events before
+    it)`` after the header and after each chunk."""
+    folder.mkdir()
+    sim = ds.EventDriven(*ds.random_gas(60, 0.4, seed=5), record=False)
+    sim.stream_chunk = 100
+    log = folder / RUN_FILES["events"]
+    sim.run(until=6.0, record_to=log, checkpoint=folder / RUN_FILES["checkpoint"], checkpoint_every=10**6)
+    walk = list(ds.io.container.iter_stream(log))
+    return log, [(end, sum(len(w[2]) for w in walk[: k + 1])) for k, (*_, end) in enumerate(walk)]
+
+
+def test_view_of_a_run_folder_whose_log_was_cut_says_where_it_stops(tmp_path, capsys):
+    log, ends = _cut_run_folder(tmp_path / "run")
+    first = next(k for k, (_, events) in enumerate(ends) if events)  # the first chunk that holds events
+    data = log.read_bytes()
+    log.write_bytes(data[: (ends[first - 1][0] + ends[first][0]) // 2])  # cut inside it
+    assert main(["view", str(tmp_path / "run")]) == 1
+    err = capsys.readouterr().err
+    assert "recorded nothing" not in err
+    saw = ds.checkpoint_info(tmp_path / "run" / RUN_FILES["checkpoint"])["stream"]["records"]
+    assert f"events.dse stops at byte {ends[first - 1][0]:,} (" in err and f"the checkpoint saw {saw:,})" in err
+    assert "whole chunks hold 0 events" in err and "nothing to replay" in err
+    assert not (tmp_path / "run" / "view.html").exists()
+    end, events = ends[first + 2]
+    assert events == 300 < saw
+    log.write_bytes(data[: end + 10])  # three chunks of events, then a cut
+    assert ds.io.container.stream_extent(log)[:2] == (end, 300)
+    assert main(["view", str(tmp_path / "run")]) == 0
+    captured = capsys.readouterr()
+    assert "300 events" in captured.out
+    assert f"note: {log} stops at byte {end:,}" in captured.err and "whole chunks hold 300 events" in captured.err
+    log.write_bytes(data)
+    assert main(["view", str(tmp_path / "run")]) == 0
+    assert "note" not in capsys.readouterr().err
+
+
+def test_ctrl_c_while_placing_the_discs_leaves_nothing_and_says_so(tmp_path, capsys, monkeypatch):
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ds, "random_gas", interrupted)
+    assert main(_args(tmp_path / "run", 3.0, 0.3, 100)) == 130
+    assert "interrupted before anything was written; run the same command again" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())

@@ -41,6 +41,40 @@ def positive_float(text: str) -> float:
     return value
 
 
+def non_negative_int(text: str) -> int:
+    """An argument type: an integer, 0 or more (a seed: ``"0"``, ``"12"``; not ``"-3"`` nor ``"1.5"``).
+
+    Example:
+        >>> non_negative_int("0")
+        0
+    """
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        msg = f"expected an integer, 0 or more, got {text!r}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    """An argument type: a finite number, 0 or more (not ``"-1"``, ``"nan"`` nor ``"inf"``).
+
+    Example:
+        >>> non_negative_float("0")
+        0.0
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value >= 0 or value == float("inf"):
+        msg = f"expected a finite number, 0 or more, got {text!r}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
 def make_output_folder(command: str, out: Path) -> bool:
     """Create the folder ``out`` (and its parents); on failure say why on stderr, naming ``command``, and return
     False."""

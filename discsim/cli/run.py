@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from discsim.cli._common import make_output_folder, positive_float, positive_int
+from discsim.cli._common import make_output_folder, non_negative_float, non_negative_int, positive_float, positive_int
 from discsim.cli.summary import print_run_summary, run_summary
 
 #: Files ``discsim run`` keeps in its output folder.
@@ -21,6 +21,8 @@ RUN_FILES = {
     "events": "events.dse",  # the event log, streamed in checksummed chunks (ds.read_events)
     "summary": "summary.json",  # the figures printed at the end
 }
+#: What ``--backend`` accepts: the event loop's backends (``EventDriven(backend=...)``).
+BACKENDS = ("auto", "python", "numba")
 #: Physical events between checkpoints unless ``--checkpoint-every`` says otherwise.
 DEFAULT_CHECKPOINT_EVERY = 1_000_000
 
@@ -42,7 +44,9 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
     parser.add_argument("--n", type=positive_int, required=True, help="number of discs")
     parser.add_argument("--packing", type=positive_float, required=True, help="packing fraction, in (0, 0.85]")
     parser.add_argument("--until", type=positive_float, required=True, help="simulated time to reach")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the initial gas (default 0)")
+    parser.add_argument(
+        "--seed", type=non_negative_int, default=0, help="seed of the initial gas, 0 or more (default 0)"
+    )
     parser.add_argument("--out", required=True, help="folder for the checkpoint, the event log and the summary")
     parser.add_argument(
         "--checkpoint-every",
@@ -51,18 +55,27 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         metavar="K",
         help=f"physical events between checkpoints (default {DEFAULT_CHECKPOINT_EVERY:,})",
     )
-    parser.add_argument("--resume", action="store_true", help="continue the run already in --out")
+    parser.add_argument(
+        "--resume", action="store_true", help="continue the run already in --out (refused if --out holds no run)"
+    )
+    parser.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        default="auto",
+        help="the event loop: numba (compiled, the fast extra), python, or auto: numba when installed (default); "
+        "a run may resume under another backend, with the same events",
+    )
     walls = parser.add_mutually_exclusive_group()
     walls.add_argument("--periodic", dest="periodic", action="store_true", default=True, help="periodic box (default)")
     walls.add_argument("--walls", dest="periodic", action="store_false", help="box with reflecting walls")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
         "--since",
-        type=float,
+        type=non_negative_float,
         default=None,
         metavar="T",
-        help="average P and Z from this time on, skipping the melting of the starting lattice "
-        "(default: a fifth of --until)",
+        help="average P and Z from this time on (0 or more, before --until), skipping the melting of the starting "
+        "lattice (default: a fifth of --until)",
     )
     parser.set_defaults(func=handle)
 
@@ -70,11 +83,11 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
 def write_json(path: Path, document: dict[str, Any]) -> None:
     """Write ``document`` as JSON atomically (temporary file, then ``os.replace``)."""
     import json
-    import os
 
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(json.dumps(document, indent=2) + "\n")
-    os.replace(tmp, path)
+    from discsim.io.container import replacing
+
+    with replacing(path) as tmp:
+        tmp.write_text(json.dumps(document, indent=2) + "\n")
 
 
 def run_identity(args: argparse.Namespace) -> dict[str, Any]:
@@ -95,6 +108,12 @@ def prepare_run_folder(args: argparse.Namespace, out: Path, files: dict[str, Pat
             "or choose another --out (nothing was changed)"
         )
     if not ours:
+        if args.resume:
+            where = "is empty" if out.is_dir() else "does not exist"
+            return (
+                f"nothing to resume: {out} {where} (no {files['run'].name}, {files['checkpoint'].name} nor "
+                f"{files['events'].name}); drop --resume to start a new run there (nothing was changed)"
+            )
         return None
     try:
         recorded = json.loads(files["run"].read_text())
@@ -106,6 +125,17 @@ def prepare_run_folder(args: argparse.Namespace, out: Path, files: dict[str, Pat
             f"{k}={recorded.get(k)!r} there, {v!r} asked" for k, v in asked.items() if recorded.get(k) != v
         )
         return f"{out} holds a different run ({diff}); choose another --out (nothing was changed)"
+    if files["checkpoint"].exists() and not files["events"].exists():
+        try:
+            stream = ds.checkpoint_info(files["checkpoint"])["stream"]
+        except ds.CheckpointError as exc:
+            return str(exc)
+        if stream is not None:  # the run streamed its events: a resume would start a log without them
+            return (
+                f"{files['events']} is missing, but the checkpoint saw {stream.get('records', 0):,} events streamed "
+                f"to it; resuming would leave them out of the log. Put the log back, or start a new run in another "
+                "folder (nothing was changed)"
+            )
     if not files["checkpoint"].exists() and files["events"].exists():
         # Killed between creating the log and the first checkpoint: only acceptable if the log is empty.
         try:
@@ -123,9 +153,10 @@ def handle(args: argparse.Namespace) -> int:
 
     import discsim as ds
 
+    if args.since is not None and args.since >= args.until:
+        print(f"discsim run: --since {args.since:g} must lie before --until {args.until:g}", file=sys.stderr)
+        return 2
     out = Path(args.out)
-    if not make_output_folder("run", out):
-        return 1
     files = {key: out / name for key, name in RUN_FILES.items()}
     problem = prepare_run_folder(args, out, files)
     if problem is not None:
@@ -134,16 +165,18 @@ def handle(args: argparse.Namespace) -> int:
     resumed = files["checkpoint"].exists()
     try:
         if resumed:
-            sim = ds.load(files["checkpoint"])
+            sim = ds.load(files["checkpoint"], backend=args.backend)
             if args.until < sim.time:
                 print(
                     f"discsim run: the run in {out} is already at t = {sim.time:g}, past --until {args.until:g}",
                     file=sys.stderr,
                 )
                 return 1
-        else:
+        else:  # the discs first: a refused gas (--packing 0.9) leaves no folder behind
             discs, box = ds.random_gas(args.n, args.packing, periodic=args.periodic, seed=args.seed)
-            sim = ds.EventDriven(discs, box, record=False)
+            sim = ds.EventDriven(discs, box, record=False, backend=args.backend)
+            if not make_output_folder("run", out):
+                return 1
             write_json(files["run"], run_identity(args))
         e0, collisions0 = sim.discs.kinetic_energy(), sim.counts["collisions"]
         start = time.perf_counter()
@@ -159,7 +192,12 @@ def handle(args: argparse.Namespace) -> int:
         print(f"discsim run: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"\ndiscsim run: interrupted; continue with the same command and --resume (from {out})", file=sys.stderr)
+        if not files["run"].exists():  # stopped while placing the discs: nothing was written, nothing to resume
+            print("\ndiscsim run: interrupted before anything was written; run the same command again", file=sys.stderr)
+        else:
+            print(
+                f"\ndiscsim run: interrupted; continue with the same command and --resume (from {out})", file=sys.stderr
+            )
         return 130
     except OSError as exc:  # a full disk, say: the last checkpoint is whole (files are replaced atomically)
         print(f"discsim run: {os_problem(exc, out)}", file=sys.stderr)

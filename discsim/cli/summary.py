@@ -35,6 +35,7 @@ def run_summary(
     return {
         **identity,
         "until": args.until,
+        "backend": sim.backend,
         "time": sim.time,
         "collisions": counts["collisions"],
         "wall_hits": counts["wall_hits"],
@@ -70,8 +71,8 @@ def print_run_summary(s: dict[str, Any], resumed: bool) -> None:
     """Print the summary ``s`` (from :func:`run_summary`) as a small table."""
     box = "periodic box" if s["periodic"] else "box with walls"
     print(
-        f"discsim run: N={s['n']}, packing {s['packing']:g}, {box}, seed {s['seed']}, t = {s['time']:g}"
-        + (" (resumed)" if resumed else "")
+        f"discsim run: N={s['n']}, packing {s['packing']:g}, {box}, seed {s['seed']}, {s['backend']} backend, "
+        f"t = {s['time']:g}" + (" (resumed)" if resumed else "")
     )
     rows = [
         ("collisions", f"{s['collisions']:,}", f"wall hits {s['wall_hits']:,}"),

@@ -46,6 +46,11 @@ def handle(args: argparse.Namespace) -> int:
 
     first = Path(args.source[0])
     path = Path(args.path) if args.path else (first if first.is_dir() else first.parent) / DEFAULT_VIEW_FILE
+    cut = [line for line in map(where_log_stops, args.source) if line is not None]
+    for line, records in cut:
+        if not records:  # nothing whole to replay: say where the log stops, not that the run recorded nothing
+            print(f"discsim view: {line}; nothing to replay", file=sys.stderr)
+            return 1
     try:
         page = view(
             args.source if len(args.source) > 1 else args.source[0],
@@ -61,4 +66,49 @@ def handle(args: argparse.Namespace) -> int:
     t0, t1 = page.span
     print(f"discsim view: wrote {page.path} ({len(page.html):,} bytes, {page.events:,} events, t in [{t0:g}, {t1:g}])")
     print("  open it in a browser; Space plays and pauses, Left/Right step a frame, Shift+Left/Right an event")
+    for line, _ in cut:
+        print(f"  note: {line}; the page replays the run up to there", file=sys.stderr)
     return 0
+
+
+def where_log_stops(source: str) -> tuple[str, int] | None:
+    """For a run folder, checkpoint or event log whose log is cut short (or damaged): a line saying where the
+    log stops, and the events before that; None when the log is whole (or there is none to look at).
+
+    Reads only the log's block lengths and chunk headers (:func:`discsim.io.container.stream_extent`).
+    """
+    import discsim as ds
+    from discsim.cli.run import RUN_FILES
+    from discsim.io.container import STATE_MAGIC, stream_extent
+
+    path = Path(source)
+    log: Path | None = path
+    checkpoint: Path | None = None
+    if path.is_dir():
+        log, checkpoint = path / RUN_FILES["events"], path / RUN_FILES["checkpoint"]
+    elif path.is_file():
+        with path.open("rb") as handle:
+            if handle.read(len(STATE_MAGIC)) == STATE_MAGIC:
+                log, checkpoint = None, path
+    try:
+        stream = ds.checkpoint_info(checkpoint)["stream"] if checkpoint and checkpoint.is_file() else None
+        if log is None and stream is not None:
+            log = Path(stream["path"])
+            log = log if log.exists() else path.parent / log.name
+        if log is None or not log.is_file():
+            return None
+        size = log.stat().st_size
+        end, records, last = stream_extent(log)
+    except (OSError, ds.DiscsimError):
+        return None  # the viewer says what is wrong with it
+    saw = stream.get("records", 0) if stream else 0
+    if end == size and records >= saw:
+        return None
+    where = f"{log} stops at byte {end:,} of {size:,}"
+    if stream and stream.get("end", 0) > size:
+        where = f"{log} stops at byte {end:,} ({size:,} in the file, {stream['end']:,} when checkpointed)"
+    until = f", up to t = {float(last['time']):g}" if "time" in last else ""
+    line = f"{where}: cut short or damaged; its whole chunks hold {records:,} events{until}"
+    if saw > records:
+        line += f" (the checkpoint saw {saw:,})"
+    return line, records

@@ -21,8 +21,9 @@ Safety: no pickle anywhere. Arrays of Python objects are refused when
 written, and a file can describe only plain numbers and JSON, so reading a
 file never runs code from it.
 
-Crash safety: :func:`write_state` writes to a temporary file in the same
-folder, syncs it and renames it over the target (``os.replace``), so a crash
+Crash safety: :func:`write_state` (like every file discsim replaces, through
+:func:`replacing`) writes to a temporary file in the same folder, syncs it and
+renames it over the target (``os.replace``), so a crash
 leaves either the old file or the new one, never half a file. A stream is
 appended in whole chunks; whoever resumes it truncates it back to a length it
 recorded (:meth:`RecordWriter.reopen`).
@@ -54,6 +55,8 @@ __all__ = [
     "iter_stream",
     "read_state",
     "read_stream",
+    "replacing",
+    "stream_extent",
     "write_state",
 ]
 
@@ -218,25 +221,55 @@ def write_state(path, meta: dict, arrays: dict[str, np.ndarray]) -> Path:
         >>> meta["time"], arrays["x"].tolist()
         (0.1, [0.0, 1.0, 2.0])
     """
-    path = Path(path)
     data = _PREFIX.pack(STATE_MAGIC, FORMAT_VERSION) + _encode_block(meta, arrays)
+    with replacing(path) as tmp, open(tmp, "wb") as handle:
+        handle.write(data)
+    return Path(path)
+
+
+@contextlib.contextmanager
+def replacing(path) -> Iterator[Path]:
+    """Replace the file ``path`` atomically: write to the temporary path this yields, in the same folder.
+
+    When the block ends without an error, the temporary file is synced to the disk and renamed over ``path``
+    (``os.replace``); on any error (a full disk, an exception midway) it is removed and ``path`` is left as it
+    was: the old file, or none. The new file gets the permissions of a newly created one.
+
+    Raises:
+        FileNotFoundError: naming ``path``, if its folder does not exist (before anything is written).
+
+    Example:
+        >>> import os, tempfile
+        >>> path = os.path.join(tempfile.mkdtemp(), "notes.txt")
+        >>> with replacing(path) as tmp:
+        ...     _ = tmp.write_text("new")
+        >>> open(path).read(), os.listdir(os.path.dirname(path))
+        ('new', ['notes.txt'])
+    """
+    path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         msg = f"cannot write {str(path)!r}: no folder {str(folder)!r}"
         raise FileNotFoundError(msg)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    os.close(fd)
+    tmp = Path(name)
     try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
+        yield tmp
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes it private (0600)
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
     _fsync_folder(folder)
-    return path
 
 
 def read_state(path) -> tuple[dict, dict[str, np.ndarray]]:
@@ -379,6 +412,49 @@ def read_stream(path, *, partial: bool = False) -> RecordStream:
         pieces.append(records)
     records = np.concatenate(pieces)
     return RecordStream(meta, arrays, records, len(pieces) - 1, end, last)
+
+
+def stream_extent(path) -> tuple[int, int, dict]:
+    """How far a record stream's whole blocks reach, read from their lengths and each chunk's JSON only.
+
+    No records are read and no checksum is checked, so this is cheap on a log of any size: use it to say where
+    a file cut short (or damaged) stops; :func:`iter_stream` verifies.
+
+    Returns:
+        ``(end, records, last)``: the byte after the last whole block (the file's size when none is cut), the
+        records in the whole chunks, and the JSON dict of the last whole chunk (empty when there is none).
+
+    Raises:
+        FileNotFoundError: if there is no such file.
+    """
+    path = Path(path)
+    size = path.stat().st_size
+    end, records = 0, 0
+    last: dict = {}
+    with open(path, "rb") as handle:
+        if len(handle.read(_PREFIX.size)) < _PREFIX.size:
+            return end, records, last
+        end = _PREFIX.size
+        header = True
+        while end + _LENGTH.size <= size:
+            handle.seek(end)
+            (body_len,) = _LENGTH.unpack(handle.read(_LENGTH.size))
+            block_end = end + _LENGTH.size + body_len + _DIGEST
+            if block_end > size:
+                break
+            if not header:
+                raw = handle.read(min(body_len, _LENGTH.size))
+                json_len = _LENGTH.unpack(raw)[0] if len(raw) == _LENGTH.size else body_len
+                if json_len > min(body_len - _LENGTH.size, _MAX_JSON):
+                    break
+                try:
+                    meta = json.loads(handle.read(json_len).decode("utf-8"))["meta"]
+                    count = int(meta["count"])
+                except (ValueError, KeyError, TypeError):
+                    break
+                records, last = records + count, meta
+            header, end = False, block_end
+    return end, records, last
 
 
 def _verify_chunks(handle, path: Path, dtype: np.dtype, position: int, end: int, records: int) -> None:

@@ -15,12 +15,18 @@ is one line in the file; it is cut here)::
   group labels, so that ASE can build its ``Atoms``; the label itself is the ``group`` column), ``pos``
   (z = 0), ``radius``, ``velo`` (z = 0), ``mass`` (``inf`` for an obstacle) and ``group``.
 
+The comment line ends with ``discsim_sha256=...``: the SHA-256 (hex) of the frame's lines without it. XYZ has
+no checksum of its own, so a damaged digit would read back as another number: :func:`read_xyz` refuses a frame
+that does not match the checksum discsim wrote; a file from another tool (no such key) is read as it stands.
+
 Numbers are written with ``repr`` (17 significant digits), so a file reads back exactly. Unwrapped positions
 are not stored: a file read back has ``unwrapped`` equal to ``positions``.
 """
 
 from __future__ import annotations
 
+import hashlib
+import re
 import shlex
 from os import PathLike
 from pathlib import Path
@@ -28,7 +34,8 @@ from pathlib import Path
 import numpy as np
 
 from discsim.analysis.frames import Frames
-from discsim.errors import InvalidArgumentError
+from discsim.errors import DiscsimError, InvalidArgumentError
+from discsim.io.container import replacing
 from discsim.model import Box
 
 __all__ = ["read_xyz", "write_xyz"]
@@ -38,6 +45,10 @@ SYMBOLS = "H He Li Be B C N O F Ne Na Mg Al Si P S Cl Ar K Ca Sc Ti V Cr Mn Fe C
 PROPERTIES = "species:S:1:pos:R:3:radius:R:1:velo:R:3:mass:R:1:group:I:1"
 #: The columns read as numbers: a file that declares one of them text (type S) is refused.
 _NUMBERS = ("pos", "radius", "velo", "mass", "group")
+#: The key of each frame's checksum, written last on its comment line: the SHA-256 (hex) of the frame's lines
+#: without it. read_xyz checks it where present; other tools keep it as an info string.
+CHECKSUM = "discsim_sha256"
+_CHECKSUM_AT_END = re.compile(rf"\s+{CHECKSUM}=(\S*)\s*$")
 
 
 def write_xyz(path, source, times=None) -> Path:
@@ -78,16 +89,18 @@ def write_xyz(path, source, times=None) -> Path:
     groups = frames.groups.tolist()
     lines = []
     for k in range(len(frames)):
-        lines.append(str(frames.n))
-        lines.append(f'Lattice="{lattice}" Properties={PROPERTIES} pbc="{pbc}" Time={float(frames.times[k])!r}')
+        comment = f'Lattice="{lattice}" Properties={PROPERTIES} pbc="{pbc}" Time={float(frames.times[k])!r}'
         pos, vel = frames.positions[k].tolist(), frames.velocities[k].tolist()
-        for d in range(frames.n):
-            lines.append(
-                f"{species[d]} {pos[d][0]!r} {pos[d][1]!r} 0.0 {radii[d]!r} {vel[d][0]!r} {vel[d][1]!r} 0.0 "
-                f"{masses[d]!r} {groups[d]}"
-            )
+        rows = [
+            f"{species[d]} {pos[d][0]!r} {pos[d][1]!r} 0.0 {radii[d]!r} {vel[d][0]!r} {vel[d][1]!r} 0.0 "
+            f"{masses[d]!r} {groups[d]}"
+            for d in range(frames.n)
+        ]
+        count = str(frames.n)
+        lines += [count, f"{comment} {CHECKSUM}={_digest(count, comment, rows)}", *rows]
     path = Path(path)
-    path.write_text("\n".join(lines) + "\n")
+    with replacing(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
     return path
 
 
@@ -114,14 +127,49 @@ def read_xyz(path: str | PathLike[str]) -> Frames:
 
     Raises:
         FileNotFoundError: if there is no such file.
-        InvalidArgumentError: if the file is not extended XYZ as above, holds 3D data (a nonzero z, or a
-            cell with a third vector), or its frames differ in the number of discs or the box.
+        InvalidArgumentError: naming the file, if it is not extended XYZ as above (or not text), holds 3D data
+            (a nonzero z, or a cell with a third vector), its frames differ in the number of discs or the box,
+            or a frame does not match the checksum discsim wrote with it (the file is damaged).
     """
     path = Path(path)
     if not path.is_file():
         msg = f"no XYZ file at {str(path)!r}"
         raise FileNotFoundError(msg)
-    lines = path.read_text().splitlines()
+    data = path.read_bytes()
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        msg = f"{path} is not a text file (XYZ): byte {exc.start}, on line {line}, is not UTF-8 text"
+        raise InvalidArgumentError(msg) from exc
+    try:
+        return _read_lines(text.splitlines(), path)
+    except DiscsimError:
+        raise
+    except (ValueError, TypeError, IndexError, KeyError, OverflowError) as exc:  # a value no check above named
+        msg = f"{path}: unreadable as extended XYZ ({type(exc).__name__}: {exc})"
+        raise InvalidArgumentError(msg) from exc
+
+
+def _digest(count: str, comment: str, rows: list[str]) -> str:
+    """The SHA-256 (hex) of a frame's lines, its comment line without the checksum."""
+    return hashlib.sha256("\n".join([count, comment, *rows]).encode()).hexdigest()
+
+
+def _verify(lines: list[str], at: int, n: int, path: Path, frame: int) -> str:
+    """Frame ``frame``'s comment line (at line ``at + 1``) without its checksum, once the frame matches it."""
+    comment = lines[at + 1]
+    found = _CHECKSUM_AT_END.search(comment)
+    if found is None:  # written by another tool (or an older discsim): nothing to check
+        return comment
+    comment = comment[: found.start()]
+    if found.group(1).lower() != _digest(lines[at], comment, lines[at + 2 : at + 2 + n]):
+        msg = f"{path} is damaged: frame {frame} (from line {at + 1}) does not match its checksum ({CHECKSUM})"
+        raise InvalidArgumentError(msg)
+    return comment
+
+
+def _read_lines(lines: list[str], path: Path) -> Frames:
     at, frame = 0, 0
     times: list[float] = []
     positions: list[np.ndarray] = []
@@ -133,13 +181,15 @@ def read_xyz(path: str | PathLike[str]) -> Frames:
             continue
         try:
             n = int(lines[at])
-        except ValueError as exc:
+        except ValueError:
+            n = -1
+        if n < 0:
             msg = f"{path}: line {at + 1} should count the discs of frame {frame}, got {lines[at][:40]!r}"
-            raise InvalidArgumentError(msg) from exc
+            raise InvalidArgumentError(msg)
         if at + 2 + n > len(lines):
             msg = f"{path}: frame {frame} announces {n} discs but the file ends first"
             raise InvalidArgumentError(msg)
-        info = _parse_comment(lines[at + 1], path, frame)
+        info = _parse_comment(_verify(lines, at, n, path, frame), path, frame)
         frame_box = _box(info, path, frame)
         columns = _columns(info, path, frame)
         rows = [lines[at + 2 + d].split() for d in range(n)]
@@ -174,7 +224,11 @@ def read_xyz(path: str | PathLike[str]) -> Frames:
             radii = table["radius"][:, 0] if "radius" in table else np.full(n, 0.5)
             masses = table["mass"][:, 0] if "mass" in table else np.ones(n)
             if "group" in table:
-                groups = table["group"][:, 0].astype(np.int64)
+                labels = table["group"][:, 0]
+                if not np.all((np.abs(labels) < 2.0**62) & (labels == np.round(labels))):
+                    msg = f"{path}: frame {frame}: column group holds values that are not integers"
+                    raise InvalidArgumentError(msg)
+                groups = labels.astype(np.int64)
             elif "species" in table:
                 names = [v[0] for v in table["species"]]
                 groups = np.unique(names, return_inverse=True)[1].reshape(-1)
@@ -184,7 +238,11 @@ def read_xyz(path: str | PathLike[str]) -> Frames:
         elif frame_box != first[0] or n != len(first[1]):
             msg = f"{path}: frame {frame} differs from frame 0 in its box or its number of discs"
             raise InvalidArgumentError(msg)
-        times.append(float(info.get("time", frame)))
+        try:
+            times.append(float(info.get("time", frame)))
+        except ValueError as exc:
+            msg = f"{path}: frame {frame}'s Time is not a number: {info['time'][:40]!r}"
+            raise InvalidArgumentError(msg) from exc
         positions.append(first[0].wrap(pos[:, :2]))
         velocities.append(table["velo"][:, :2] if "velo" in table else np.zeros((n, 2)))
         at += 2 + n

@@ -58,6 +58,7 @@ from discsim.run.observers import Callback, Checkpointer, EventStream, Observer,
 from discsim.run.samplers import GSDWriter, Sampler
 from discsim.run.sweep import sweep
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
+from discsim.spatial import RayHit
 from discsim.view import View, view  # cheap (no matplotlib); binds ds.view to the function, not the module
 
 __version__ = "0.1.0"
@@ -106,6 +107,7 @@ __all__ = [
     "OverlapError",
     "PackingError",
     "ProgressBar",
+    "RayHit",
     "Sampler",
     "Scenario",
     "Segment",

@@ -47,6 +47,7 @@ import numpy as np
 
 from discsim.engines.context import RunContext
 from discsim.engines.editing import DiscEditing
+from discsim.engines.queries import SpatialQueries
 from discsim.engines.record import EventRecord
 from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError, WrongTypeError
 from discsim.model import Box, Discs, kinetic_energy, momentum
@@ -164,11 +165,12 @@ class EngineState:
         return cls(**given)
 
 
-class Engine(DiscEditing, EventRecord, ABC):
+class Engine(DiscEditing, EventRecord, SpatialQueries, ABC):
     """Base class of discsim engines; see the module docstring for the protocols.
 
     The disc-editing methods come from :class:`~discsim.engines.editing.DiscEditing`, the log's readers
-    (``events``, ``trajectory``) from :class:`~discsim.engines.record.EventRecord`.
+    (``events``, ``trajectory``) from :class:`~discsim.engines.record.EventRecord`, the spatial queries
+    (``disc_at``, ``nearest``, ``within``, ``ray_cast``) from :class:`~discsim.engines.queries.SpatialQueries`.
     """
 
     #: The name of ``run()``'s count of units of work ("events" or "frames").

@@ -180,6 +180,9 @@ class Compression(Engine):
         """``(N,)`` radii now (before the final shrink :meth:`snapshot` applies)."""
         return _readonly(self._state.radii.copy())
 
+    def _radii_now(self) -> np.ndarray:
+        return self._state.radii
+
     @property
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres now (wrapped into a periodic box)."""

@@ -29,6 +29,7 @@ from discsim.analysis.theory import (
 )
 from discsim.analysis.thermo import compressibility_factor, thermo
 from discsim.engines.compress import Compression, CompressionReport, compress
+from discsim.engines.event_chain import EventChain
 from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import POLICIES, FixedStep, FixedStepState
 from discsim.errors import (
@@ -90,6 +91,7 @@ __all__ = [
     "Discs",
     "DiscsimError",
     "Event",
+    "EventChain",
     "EventDriven",
     "EventDrivenState",
     "EventKind",

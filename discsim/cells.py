@@ -16,7 +16,7 @@ import numpy as np
 from discsim.errors import BoxTooSmallError, InvalidArgumentError
 from discsim.model import Box
 
-__all__ = ["CellGrid", "cells_along", "grid_counts", "grid_shape", "neighbour_pairs"]
+__all__ = ["CellGrid", "cell_lists", "cells_along", "grid_counts", "grid_shape", "neighbour_pairs"]
 
 
 def grid_shape(box: Box, min_cell: float, max_cells: int | None = None, what: str | None = None) -> tuple[int, int]:
@@ -252,3 +252,21 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
     i = np.concatenate(parts_i)
     j = np.concatenate(parts_j)
     return i, j, box.minimum_image(positions[j] - positions[i])
+
+
+def cell_lists(cells: np.ndarray, size: int):
+    """``head`` ``(size,)`` (first disc of each cell, -1 if none), ``nxt`` and ``prv`` ``(N,)``: the discs of
+    ``cells`` ``(N,)`` (each disc's flat cell index) as doubly linked lists by cell, as the compiled loops keep
+    them (the compression's, the event chains'); int64, numpy only."""
+    order = np.argsort(cells, kind="stable")
+    ordered = cells[order]
+    same = ordered[1:] == ordered[:-1]
+    nxt = np.full(len(cells), -1, dtype=np.int64)
+    prv = np.full(len(cells), -1, dtype=np.int64)
+    nxt[order[:-1][same]] = order[1:][same]
+    prv[order[1:][same]] = order[:-1][same]
+    head = np.full(size, -1, dtype=np.int64)
+    first = np.ones(len(cells), dtype=bool)
+    first[1:] = ~same
+    head[ordered[first]] = order[first]
+    return head, nxt, prv

@@ -38,14 +38,14 @@ def _engine_classes() -> dict[str, type]:
 
 def test_the_registry_knows_every_engine():
     defined = _engine_classes()
-    assert set(defined) >= {"Compression", "EventDriven", "FixedStep"}
+    assert set(defined) >= {"Compression", "EventChain", "EventDriven", "FixedStep"}
     assert base.registered_engines() == defined
     for name, cls in defined.items():
         assert base.engine_class(name) is cls
 
 
 def test_an_unknown_name_is_refused_naming_the_known_ones():
-    known = r"'Nope' \(known: \['Compression', 'EventDriven', 'FixedStep'\]\)"
+    known = r"'Nope' \(known: \['Compression', 'EventChain', 'EventDriven', 'FixedStep'\]\)"
     with pytest.raises(ds.InvalidArgumentError, match=known):
         base.engine_class("Nope")
 
@@ -88,7 +88,10 @@ def test_the_old_table_of_engines_still_answers_with_a_warning():
 
     with pytest.warns(DeprecationWarning, match="registered_engines"):
         engines = checkpoints.ENGINES
-    assert engines == {"Compression": ds.Compression, "EventDriven": ds.EventDriven, "FixedStep": ds.FixedStep}
+    assert engines == {
+        "Compression": ds.Compression, "EventChain": ds.EventChain, "EventDriven": ds.EventDriven,
+        "FixedStep": ds.FixedStep,
+    }  # fmt: skip
 
 
 def test_an_engine_module_imported_alone_runs_and_saves(tmp_path):

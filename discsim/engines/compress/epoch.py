@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from discsim.cells import neighbour_pairs
+from discsim.cells import cell_lists, neighbour_pairs
 from discsim.engines.compress import loop
 from discsim.model import Box
 
@@ -49,7 +49,7 @@ def epoch(positions, velocities, radii, masses, box: Box, grid: tuple[int, int],
     cells = np.clip((positions[:, 0] / cw).astype(np.int64), 0, nx - 1) * ny + np.clip(
         (positions[:, 1] / ch).astype(np.int64), 0, ny - 1
     )
-    head, nxt, prv = _cell_lists(cells, nx * ny)
+    head, nxt, prv = cell_lists(cells, nx * ny)
     x, y = floats(positions[:, 0]), floats(positions[:, 1])
     vx, vy = floats(velocities[:, 0]), floats(velocities[:, 1])
     out, iout = floats([0.0, 0.0, 0.0]), ints([0, 0, 0, 0])
@@ -70,22 +70,6 @@ def epoch(positions, velocities, radii, masses, box: Box, grid: tuple[int, int],
         "wall_virial": float(out[2]),
     }
     return positions, velocities, float(t), stats
-
-
-def _cell_lists(cells: np.ndarray, size: int):
-    """``head`` (first disc of each cell, -1 if none), ``nxt`` and ``prv``: doubly linked lists by cell, numpy only."""
-    order = np.argsort(cells, kind="stable")
-    ordered = cells[order]
-    same = ordered[1:] == ordered[:-1]
-    nxt = np.full(len(cells), -1, dtype=np.int64)
-    prv = np.full(len(cells), -1, dtype=np.int64)
-    nxt[order[:-1][same]] = order[1:][same]
-    prv[order[1:][same]] = order[:-1][same]
-    head = np.full(size, -1, dtype=np.int64)
-    first = np.ones(len(cells), dtype=bool)
-    first[1:] = ~same
-    head[ordered[first]] = order[first]
-    return head, nxt, prv
 
 
 def shrink_factor(positions: np.ndarray, radii: np.ndarray, box: Box) -> float:

@@ -16,7 +16,10 @@ import numpy as np
 from discsim.errors import BoxTooSmallError, InvalidArgumentError
 from discsim.model import Box
 
-__all__ = ["CellGrid", "cell_lists", "cells_along", "grid_counts", "grid_shape", "neighbour_pairs"]
+__all__ = [
+    "CellGrid", "cell_lists", "cells_along", "flat_cells", "grid_counts", "grid_shape", "link", "neighbour_pairs",
+    "unlink",
+]  # fmt: skip
 
 
 def grid_shape(box: Box, min_cell: float, max_cells: int | None = None, what: str | None = None) -> tuple[int, int]:
@@ -125,9 +128,7 @@ class CellGrid:
 
     def cells_of(self, positions: np.ndarray) -> np.ndarray:
         """Flat cell index ``(N,)`` of each row of ``positions`` ``(N, 2)``."""
-        cx = np.clip((positions[:, 0] / self.lx).astype(np.int64), 0, self.nx - 1)
-        cy = np.clip((positions[:, 1] / self.ly).astype(np.int64), 0, self.ny - 1)
-        return cx * self.ny + cy
+        return flat_cells(positions, self.nx, self.ny, self.lx, self.ly)
 
     def segments_by_cell(self, segments, reach: float) -> list[tuple[int, ...]]:
         """For each cell, the indices of the segments that pass within ``reach`` of it.
@@ -270,3 +271,35 @@ def cell_lists(cells: np.ndarray, size: int):
     first[1:] = ~same
     head[ordered[first]] = order[first]
     return head, nxt, prv
+
+
+def flat_cells(positions: np.ndarray, nx: int, ny: int, lx: float, ly: float) -> np.ndarray:
+    """Flat cell index ``cx * ny + cy`` ``(N,)`` of each row of ``positions`` ``(N, 2)`` in a grid of ``nx`` by
+    ``ny`` cells of ``lx`` by ``ly`` (clipped to the grid: a centre on the far edge is in the last cell)."""
+    cx = np.clip((positions[:, 0] / lx).astype(np.int64), 0, nx - 1)
+    cy = np.clip((positions[:, 1] / ly).astype(np.int64), 0, ny - 1)
+    return cx * ny + cy
+
+
+# The doubly linked cell lists of the loops that keep them (the compression's, the event chains'): plain
+# arithmetic on indexable ``head``, ``nxt``, ``prv``, so numba compiles these very functions into those loops.
+def unlink(i, c, head, nxt, prv):
+    """Take disc ``i`` out of cell ``c``'s list."""
+    p = prv[i]
+    q = nxt[i]
+    if p >= 0:
+        nxt[p] = q
+    else:
+        head[c] = q
+    if q >= 0:
+        prv[q] = p
+
+
+def link(i, c, head, nxt, prv):
+    """Put disc ``i`` at the head of cell ``c``'s list."""
+    q = head[c]
+    nxt[i] = q
+    prv[i] = -1
+    if q >= 0:
+        prv[q] = i
+    head[c] = i

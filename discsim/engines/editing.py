@@ -10,16 +10,16 @@ and counted. A mixin of :class:`~discsim.engines.base.Engine`: it reads the engi
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, NoReturn
 
 import numpy as np
 
 from discsim.engines.context import RunContext, readonly_ids
-from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
+from discsim.errors import DiscsimError, InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, _real_array
 from discsim.scene import Scene, check_added
 
-__all__ = ["DiscEditing"]
+__all__ = ["DiscEditing", "Uneditable"]
 
 
 class DiscEditing:
@@ -386,3 +386,29 @@ class DiscEditing:
                     f"(distance {dist[j]:.6g}, contact distance {contact[j]:.6g})"
                 )
                 raise OverlapError(msg)
+
+
+class Uneditable:
+    """For engines whose discs cannot be changed mid-run (a compression, an event chain): the edits, the
+    callbacks and ``trajectory`` are refused before anything changes, naming the engine and, from
+    ``EDIT_REFUSAL``, what to do instead. Put it before :class:`~discsim.engines.base.Engine` in the bases."""
+
+    #: What a refusal suggests instead.
+    EDIT_REFUSAL: ClassVar[str] = "start a new engine from sim.snapshot() instead"
+
+    def _check_editable(self, what: str) -> None:
+        self._refuse(what)
+
+    def _set_discs(self, indices, positions, velocities) -> None:
+        self._refuse("change discs")
+
+    def _restructure(self, keep, added, scene) -> None:
+        self._refuse("add or remove discs")
+
+    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
+        """Refused: this engine keeps no log of paths."""
+        self._refuse("give trajectories")
+
+    def _refuse(self, what: str) -> NoReturn:
+        msg = f"a {type(self).__name__} cannot {what}: {self.EDIT_REFUSAL}"
+        raise DiscsimError(msg)

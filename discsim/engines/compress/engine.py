@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import time as _time
 from dataclasses import dataclass
-from typing import Any, ClassVar, NoReturn
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -21,7 +21,8 @@ from discsim.cells import grid_shape
 from discsim.engines.base import Engine, EngineState, register_engine
 from discsim.engines.compress.epoch import epoch, shrink_factor
 from discsim.engines.compress.report import DENSEST_PACKING, HISTORY, CompressionReport
-from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError, PackingError, WrongTypeError
+from discsim.engines.editing import Uneditable
+from discsim.errors import CheckpointError, InvalidArgumentError, PackingError, WrongTypeError
 from discsim.model import Box, Discs, _readonly
 from discsim.scene import Scene, check_fits
 
@@ -61,7 +62,7 @@ class CompressionState(EngineState):
 
 
 @register_engine
-class Compression(Engine):
+class Compression(Uneditable, Engine):
     """Grow all discs until they fill ``packing_fraction`` of the box (Lubachevsky-Stillinger), exactly.
 
     An engine whose unit of work is a thermostat epoch: ``run()`` goes on to the end (the target, a jam
@@ -90,6 +91,9 @@ class Compression(Engine):
     progress_chunk: ClassVar[int] = 1
     runs_to_end: ClassVar[bool] = True
     STATE = CompressionState
+    EDIT_REFUSAL: ClassVar[str] = (
+        "the discs grow and no log is kept; compress first, then build an EventDriven from compression.snapshot()"
+    )
 
     def __init__(
         self,
@@ -396,27 +400,6 @@ class Compression(Engine):
             raise CheckpointError(msg)
         sim._state = state
         return sim
-
-    # --- refused ------------------------------------------------------------------------------
-    def _set_discs(self, indices, positions, velocities) -> None:
-        self._refuse("change discs")
-
-    def _restructure(self, keep, added, scene) -> None:
-        self._refuse("add or remove discs")
-
-    def _check_editable(self, what: str) -> None:
-        self._refuse(what)
-
-    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
-        """Refused: a compression keeps no event log."""
-        self._refuse("give trajectories")
-
-    def _refuse(self, what: str) -> NoReturn:
-        msg = (
-            f"a Compression cannot {what}: the discs grow and no log is kept; compress first, then build an "
-            "EventDriven from compression.snapshot()"
-        )
-        raise DiscsimError(msg)
 
 
 def compress(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from discsim.cells import cell_lists, neighbour_pairs
+from discsim.cells import cell_lists, flat_cells, neighbour_pairs
 from discsim.engines.compress import loop
 from discsim.model import Box
 
@@ -46,9 +46,7 @@ def epoch(positions, velocities, radii, masses, box: Box, grid: tuple[int, int],
             return [int(v) for v in a]
 
     cw, ch = box.width / nx, box.height / ny
-    cells = np.clip((positions[:, 0] / cw).astype(np.int64), 0, nx - 1) * ny + np.clip(
-        (positions[:, 1] / ch).astype(np.int64), 0, ny - 1
-    )
+    cells = flat_cells(positions, nx, ny, cw, ch)
     head, nxt, prv = cell_lists(cells, nx * ny)
     x, y = floats(positions[:, 0]), floats(positions[:, 1])
     vx, vy = floats(velocities[:, 0]), floats(velocities[:, 1])

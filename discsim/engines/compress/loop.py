@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 
+from discsim.cells import link, unlink
 from discsim.physics.dynamics import advance
 from discsim.queue import sift_down, sift_up  # the indexed heap (by (time, owner)) of the compiled loops
 
@@ -183,26 +184,6 @@ def _advance(i, t, x, y, vx, vy, tr):
     tr[i] = t
 
 
-def _unlink(i, c, head, nxt, prv):
-    p = prv[i]
-    q = nxt[i]
-    if p >= 0:
-        nxt[p] = q
-    else:
-        head[c] = q
-    if q >= 0:
-        prv[q] = p
-
-
-def _link(i, c, head, nxt, prv):
-    q = head[c]
-    nxt[i] = q
-    prv[i] = -1
-    if q >= 0:
-        prv[q] = i
-    head[c] = i
-
-
 def run_epoch(x, y, vx, vy, tr, r0, m, count, cell, head, nxt, prv, heap, ht, hpos, qk, qo, qs, par, ipar, out, iout):
     """Run one epoch from time 0 (all discs synchronised there, cells filled); see the module's docstring.
 
@@ -338,9 +319,9 @@ def run_epoch(x, y, vx, vy, tr, r0, m, count, cell, head, nxt, prv, heap, ht, hp
                 if cy < 0:
                     cy = ncy - 1
                     y[i] += height
-            _unlink(i, c, head, nxt, prv)
+            unlink(i, c, head, nxt, prv)
             c = cx * ncy + cy
-            _link(i, c, head, nxt, prv)
+            link(i, c, head, nxt, prv)
             cell[i] = c
             crossings += 1
         set_time(
@@ -367,7 +348,7 @@ ORDER = (
     "set_time",
     "predict",
     "_advance",
-    "_unlink",
-    "_link",
+    "unlink",
+    "link",
     "run_epoch",
 )

@@ -11,16 +11,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar, NoReturn
+from typing import Any, ClassVar
 
 import numpy as np
 
 from discsim import _numba
 from discsim._interrupt import deferred_interrupt
-from discsim.cells import cell_lists, grid_shape
+from discsim.cells import cell_lists, flat_cells, grid_shape
 from discsim.engines.base import Engine, EngineState, register_engine
+from discsim.engines.editing import Uneditable
 from discsim.engines.event_chain import loop
-from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
+from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.model import Box, Discs, _readonly
 from discsim.scene import Scene
 
@@ -54,7 +55,7 @@ class EventChainState(EngineState):
 
 
 @register_engine
-class EventChain(Engine):
+class EventChain(Uneditable, Engine):
     """Straight event-chain Monte Carlo of hard discs in a periodic box: the canonical ensemble, exactly.
 
     Each chain picks a disc at random and moves it along +x (chains alternate +x and +y) until it would touch
@@ -89,6 +90,7 @@ class EventChain(Engine):
     rate_count: ClassVar[str] = "lifts"
     progress_chunk: ClassVar[int] = 2000
     STATE = EventChainState
+    EDIT_REFUSAL: ClassVar[str] = "start a new one from sim.snapshot() instead"
 
     def __init__(
         self,
@@ -124,9 +126,7 @@ class EventChain(Engine):
         self._configure(Scene(discs, box), settings)
         positions = box.wrap(np.array(discs.positions, dtype=float))
         nx, ny = self._grid
-        cells = np.clip((positions[:, 0] / (box.width / nx)).astype(np.int64), 0, nx - 1) * ny + np.clip(
-            (positions[:, 1] / (box.height / ny)).astype(np.int64), 0, ny - 1
-        )
+        cells = flat_cells(positions, nx, ny, box.width / nx, box.height / ny)
         self._state = EventChainState(positions, np.zeros((len(discs), 2), dtype=np.int64), cells, 0, 0, 0, 0.0)
 
     def _configure(self, scene: Scene, settings: dict) -> None:
@@ -310,21 +310,3 @@ class EventChain(Engine):
             int(state.lifts), int(state.crossings), float(state.separation),
         )  # fmt: skip
         return sim
-
-    # --- refused ---------------------------------------------------------------------------------------
-    def _set_discs(self, indices, positions, velocities) -> None:
-        self._refuse("change discs")
-
-    def _restructure(self, keep, added, scene) -> None:
-        self._refuse("add or remove discs")
-
-    def _check_editable(self, what: str) -> None:
-        self._refuse(what)
-
-    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
-        """Refused: an event chain has no time and keeps no log."""
-        self._refuse("give trajectories")
-
-    def _refuse(self, what: str) -> NoReturn:
-        msg = f"an EventChain cannot {what}: start a new one from sim.snapshot() instead"
-        raise DiscsimError(msg)

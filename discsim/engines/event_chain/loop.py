@@ -24,27 +24,9 @@ from __future__ import annotations
 
 import math
 
+from discsim.cells import link, unlink
+
 INF = math.inf
-
-
-def _unlink(i, c, head, nxt, prv):
-    p = prv[i]
-    q = nxt[i]
-    if p >= 0:
-        nxt[p] = q
-    else:
-        head[c] = q
-    if q >= 0:
-        prv[q] = p
-
-
-def _link(i, c, head, nxt, prv):
-    q = head[c]
-    nxt[i] = q
-    prv[i] = -1
-    if q >= 0:
-        prv[q] = i
-    head[c] = i
 
 
 def ahead(i, along_x, x, y, r, cell, head, nxt, par, ipar):
@@ -147,7 +129,7 @@ def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, io
                 i = j
             elif edge <= remaining:  # to the cell's edge, into the next cell
                 remaining -= edge
-                _unlink(i, c, head, nxt, prv)
+                unlink(i, c, head, nxt, prv)
                 if along_x:
                     cx += 1
                     x[i] = cx * cw
@@ -163,7 +145,7 @@ def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, io
                         y[i] = 0.0
                         iy[i] += 1
                 c = cx * ncy + cy
-                _link(i, c, head, nxt, prv)
+                link(i, c, head, nxt, prv)
                 cell[i] = c
                 crossings += 1
             else:  # the chain ends here
@@ -179,4 +161,4 @@ def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, io
 
 
 #: The functions, callees before callers, in the order :mod:`.compiled` compiles them.
-ORDER = ("_unlink", "_link", "ahead", "run_chains")
+ORDER = ("unlink", "link", "ahead", "run_chains")

@@ -129,7 +129,7 @@ def drive(
         CheckpointError: if ``record_to`` or ``checkpoint`` names a foreign or damaged file.
             Nothing has been simulated then.
     """
-    engine._check_usable()
+    engine._check_can_advance()  # also refuses a run from inside a run (an observer or a callback)
     unit = engine.unit
     stop, limit = run_limits(until, limit, engine.time, unit)
     if checkpoint_every is not None and (not is_count(checkpoint_every) or checkpoint_every == 0):
@@ -239,6 +239,7 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
     completed = False
     try:
         context.recording = wants_events  # the loop logs for the observers, whatever record says
+        context.serving = True  # step() and run() refused until the end
         try:
             for observer in chain:
                 observer.start(engine, plan)
@@ -278,7 +279,7 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
                 break
         completed = True
     finally:
-        context.recording = False
+        context.recording = context.serving = False
         for observer in reversed(started):
             observer.finish(engine, completed)
     return done

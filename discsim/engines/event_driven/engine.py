@@ -308,7 +308,7 @@ class EventDriven(RunStops, Engine):
             pair drifts alike, or moves relative to itself only along x or only
             along y and misses; see :meth:`_never_again`).
         """
-        self._check_usable()
+        self._check_can_advance()
         if self._advance(INF, 1) == 0:
             return None
         last = self._backend.last_event()

@@ -484,7 +484,7 @@ class FixedStep(Engine):
             >>> sim.velocities.tolist()
             [[-2.0, 0.0]]
         """
-        self._check_usable()
+        self._check_can_advance()
         return self._frame()
 
     def _frame(self) -> list[Event]:

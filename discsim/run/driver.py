@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from discsim._interrupt import interrupted_outside_the_loop
 from discsim._validate import check_count, check_until, is_count
 from discsim.engines.base import provide
-from discsim.errors import InvalidArgumentError, TimeError
+from discsim.errors import Interrupted, InvalidArgumentError, TimeError
 from discsim.run.handlers import EventHandlers
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 
@@ -270,8 +271,13 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
                 log.clear()
             mark = len(log)
             units = engine._units()
-            for observer in chain:
-                observer.update(engine, events, k, finishing)
+            try:
+                for observer in chain:
+                    observer.update(engine, events, k, finishing)
+            except Interrupted:
+                raise
+            except KeyboardInterrupt as exc:  # Ctrl-C in a slow callback: between two whole events, as Interrupted
+                raise interrupted_outside_the_loop() from exc
             if engine._units() != units:
                 msg = "an observer advanced the engine (step() or run() inside a run); observers may only look"
                 raise InvalidArgumentError(msg)

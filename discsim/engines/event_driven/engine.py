@@ -219,7 +219,8 @@ class EventDriven(RunStops, Engine):
             unwrapped = old.unwrapped_positions()[keep]
             state.images[: len(keep)] = image_steps(unwrapped, scene.discs.positions[: len(keep)], box.size)
         backend.start(state)
-        self.grid, self._backend, self._jam_mark = grid, backend, None
+        self.grid, self._backend = grid, backend
+        self._jam_mark = self._jam_counts = self._jam_scale = None  # new discs: the jam guard starts afresh
 
     # --- the user's protocol -------------------------------------------------------------
     @property

@@ -15,7 +15,7 @@ from contextlib import contextmanager
 
 from discsim.errors import Interrupted
 
-__all__ = ["deferred_interrupt"]
+__all__ = ["deferred_interrupt", "interrupted_outside_the_loop"]
 
 
 @contextmanager
@@ -49,3 +49,15 @@ def deferred_interrupt():
             raise Interrupted(msg)
         if callable(previous):
             previous(signal.SIGINT, None)
+
+
+def interrupted_outside_the_loop() -> Interrupted:
+    """The :class:`~discsim.errors.Interrupted` for a plain ``KeyboardInterrupt`` raised between two whole events,
+    outside the engine's loop: in an observer or a ``sim.on`` callback (Ctrl-C during a slow one, or the callback's
+    own ``raise KeyboardInterrupt``). The engine is consistent there; the caller raises it ``from`` the original.
+    """
+    msg = (
+        "interrupted (Ctrl-C) in an observer or callback, after the last whole event; the engine is consistent "
+        "and can go on"
+    )
+    return Interrupted(msg)

@@ -17,8 +17,8 @@ from discsim.errors import BoxTooSmallError, InvalidArgumentError
 from discsim.model import Box
 
 __all__ = [
-    "CellGrid", "cell_lists", "cells_along", "flat_cells", "grid_counts", "grid_shape", "link", "neighbour_pairs",
-    "unlink",
+    "CellGrid", "cell_lists", "cells_along", "flat_cells", "grid_counts", "grid_shape", "link",
+    "neighbour_pair_chunks", "neighbour_pairs", "unlink",
 ]  # fmt: skip
 
 
@@ -198,7 +198,8 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
 
     Returns:
         ``(i, j, d)``: int arrays ``(P,)`` with ``i != j`` and ``d`` ``(P, 2)``
-        the displacement from ``i`` to ``j``. O(N + P).
+        the displacement from ``i`` to ``j``. O(N + P): ``P`` grows as ``N^2`` when points crowd one
+        cell; :func:`neighbour_pair_chunks` gives the same pairs in pieces of bounded memory.
 
     Example:
         >>> import numpy as np
@@ -207,10 +208,37 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
         >>> sorted(zip(i.tolist(), j.tolist()))
         [(0, 1)]
     """
-    n = len(positions)
-    empty = np.zeros(0, dtype=np.int64)
-    if n < 2:
+    parts = list(neighbour_pair_chunks(positions, cell_size, box, max_pairs=None))
+    if not parts:
+        empty = np.zeros(0, dtype=np.int64)
         return empty, empty, np.zeros((0, 2))
+    if len(parts) == 1:
+        return parts[0]
+    i, j, d = zip(*parts)
+    return np.concatenate(i), np.concatenate(j), np.concatenate(d)
+
+
+#: Pairs per piece of :func:`neighbour_pair_chunks` by default: about 50 MB of arrays.
+CHUNK_PAIRS = 1 << 20
+
+
+def neighbour_pair_chunks(positions: np.ndarray, cell_size: float, box: Box, max_pairs: int | None = CHUNK_PAIRS):
+    """The pairs of :func:`neighbour_pairs`, in the same order, as pieces of at most ``max_pairs`` pairs.
+
+    A piece holds more only when one point alone has more candidates (at most ``N - 1``), so memory stays
+    O(N + max_pairs) however the points crowd: 10^5 points at one spot make 5 10^9 pairs, which no one
+    holds at once, and a caller looking for the first bad pair stops at the first piece holding one.
+
+    Args:
+        positions, cell_size, box: as :func:`neighbour_pairs`.
+        max_pairs: pairs per piece (None: one piece per cell offset, as they come).
+
+    Yields:
+        ``(i, j, d)`` as :func:`neighbour_pairs` returns them; no empty piece.
+    """
+    n = len(positions)
+    if n < 2:
+        return
     # At most max(4 N, 65536) cells bounds the cell-start table when few points share a large box;
     # a tiny periodic box gets one cell, and every pair is a candidate.
     nx, ny = grid_shape(box, cell_size, max(4 * n, 1 << 16))
@@ -222,37 +250,40 @@ def neighbour_pairs(positions: np.ndarray, cell_size: float, box: Box):
     np.cumsum(np.bincount(cell, minlength=nx * ny), out=cell_start[1:])
     rank = np.empty(n, dtype=np.int64)
     rank[order] = np.arange(n)
-    parts_i, parts_j = [], []
-    if nx * ny == 1:
-        ii, jj = np.triu_indices(n, 1)
-        parts_i.append(ii)
-        parts_j.append(jj)
-    else:
-        for dx, dy in ((0, 0), (1, 0), (1, 1), (0, 1), (-1, 1)):
-            ox, oy = cx + dx, cy + dy
-            if box.periodic:
-                ox, oy = ox % nx, oy % ny
-                valid = np.ones(n, dtype=bool)
-            else:
-                valid = (ox >= 0) & (ox < nx) & (oy < ny)
-            target = np.where(valid, ox * ny + oy, 0)
-            start = cell_start[target]
-            stop = cell_start[target + 1]
-            if dx == 0 and dy == 0:
-                start = rank + 1  # same cell: only later members, each pair once
-            count = np.where(valid, np.maximum(stop - start, 0), 0)
-            total = int(count.sum())
-            if total == 0:
-                continue
-            owner = np.repeat(np.arange(n), count)
-            first = np.repeat(start - (np.cumsum(count) - count), count)
-            parts_i.append(owner)
-            parts_j.append(order[first + np.arange(total)])
-    if not parts_i:
-        return empty, empty, np.zeros((0, 2))
-    i = np.concatenate(parts_i)
-    j = np.concatenate(parts_j)
-    return i, j, box.minimum_image(positions[j] - positions[i])
+    # One cell: its later members are every pair once (the other offsets would count them again).
+    offsets = ((0, 0),) if nx * ny == 1 else ((0, 0), (1, 0), (1, 1), (0, 1), (-1, 1))
+    for dx, dy in offsets:
+        ox, oy = cx + dx, cy + dy
+        if box.periodic:
+            ox, oy = ox % nx, oy % ny
+            valid = np.ones(n, dtype=bool)
+        else:
+            valid = (ox >= 0) & (ox < nx) & (oy < ny)
+        target = np.where(valid, ox * ny + oy, 0)
+        start = cell_start[target]
+        stop = cell_start[target + 1]
+        if dx == 0 and dy == 0:
+            start = rank + 1  # same cell: only later members, each pair once
+        count = np.where(valid, np.maximum(stop - start, 0), 0)
+        ends = np.cumsum(count)  # pairs of the owners up to and including each one
+        total = int(ends[-1])
+        if total == 0:
+            continue
+        # Owners [lo, hi) at a time, their pairs at most max_pairs (or one owner's, when it alone has more).
+        lo = 0
+        while lo < n:
+            base = int(ends[lo] - count[lo])
+            hi = n if max_pairs is None else max(lo + 1, int(np.searchsorted(ends, base + max_pairs, "right")))
+            size = int(ends[hi - 1]) - base
+            if size:
+                owners = np.arange(lo, hi)
+                piece = count[lo:hi]
+                owner = np.repeat(owners, piece)
+                first = np.repeat(start[lo:hi] - (ends[lo:hi] - piece - base), piece)
+                i = owner
+                j = order[first + np.arange(size)]
+                yield i, j, box.minimum_image(positions[j] - positions[i])
+            lo = hi
 
 
 def cell_lists(cells: np.ndarray, size: int):

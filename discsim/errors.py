@@ -63,7 +63,8 @@ class TimeError(DiscsimError, ValueError):
 class JammedError(DiscsimError, RuntimeError):
     """Discs wedged against each other (or a wall) collide for ever without the clock moving.
 
-    Raised by a run after many events in a row at one instant (see ``EventDriven.jam_events``); the message
+    Raised by a run after many events in a row at one instant, or while the clock creeps towards an instant it
+    never reaches (an unbounded cascade: see ``EventDriven.jam_events`` and ``EventDriven.jam_time``); the message
     names the jammed discs and the time. The engine is consistent at its last whole event.
     """
 

@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 
-from discsim.cells import neighbour_pairs
+from discsim.cells import neighbour_pair_chunks
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, RESOLUTION, Box, Discs, Segment, normalize_pass_through
 
@@ -56,7 +56,9 @@ def check_fits(
 
     Raises:
         OutsideBoxError: naming the disc, its position and radius (and the segment).
-        OverlapError: naming the deepest overlapping pair and the depth.
+        OverlapError: naming the deepest overlapping pair and the depth (of the first piece of candidate
+            pairs, :func:`~discsim.cells.neighbour_pair_chunks`, that holds an overlap: memory stays
+            O(N + 2^20) however the discs crowd).
     """
     pos, rad = discs.positions, discs.radii
     if len(discs) <= new_from:
@@ -82,27 +84,30 @@ def check_fits(
             i = int(np.flatnonzero(cut)[0])
             msg = f"{new} {i} at {pos[i].tolist()} with radius {rad[i]:g} is cut by segment {k} {segment!r}"
             raise OutsideBoxError(msg)
-    i, j, d = neighbour_pairs(pos, 2.0 * float(rad.max()), box)
-    if new_from:
-        keep = np.maximum(i, j) >= new_from
-        i, j, d = i[keep], j[keep], d[keep]
-    if pass_through:
-        group, blocked = filter_table(discs.groups, pass_through)
-        keep = ~blocked[group[i], group[j]]
-        i, j, d = i[keep], j[keep], d[keep]
-    contact = rad[i] + rad[j]
-    dist = np.hypot(d[:, 0], d[:, 1])
-    depth = contact - dist
-    bad = depth > tolerance * contact
-    if bad.any():
-        k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
-        a, b = min(int(i[k]), int(j[k])), max(int(i[k]), int(j[k]))
-        which = f"{new} {b} at {pos[b].tolist()} would overlap {'new ' if a >= new_from else ''}disc {a}"
-        msg = (
-            f"{which if new_from else f'discs {a} and {b} overlap'} by {depth[k]:.6g} "
-            f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
-        )
-        raise OverlapError(msg)
+    # The candidate pairs in pieces of bounded memory (10^5 discs at one spot make 5 10^9 of them), each
+    # piece checked as it comes: the first piece holding an overlap names its deepest one.
+    table = filter_table(discs.groups, pass_through) if pass_through else None
+    for i, j, d in neighbour_pair_chunks(pos, 2.0 * float(rad.max()), box):
+        if new_from:
+            keep = np.maximum(i, j) >= new_from
+            i, j, d = i[keep], j[keep], d[keep]
+        if table is not None:
+            group, blocked = table
+            keep = ~blocked[group[i], group[j]]
+            i, j, d = i[keep], j[keep], d[keep]
+        contact = rad[i] + rad[j]
+        dist = np.hypot(d[:, 0], d[:, 1])
+        depth = contact - dist
+        bad = depth > tolerance * contact
+        if bad.any():
+            k = int(np.argmax(np.where(bad, depth / contact, -np.inf)))
+            a, b = min(int(i[k]), int(j[k])), max(int(i[k]), int(j[k]))
+            which = f"{new} {b} at {pos[b].tolist()} would overlap {'new ' if a >= new_from else ''}disc {a}"
+            msg = (
+                f"{which if new_from else f'discs {a} and {b} overlap'} by {depth[k]:.6g} "
+                f"(distance {dist[k]:.6g}, contact distance {contact[k]:.6g})"
+            )
+            raise OverlapError(msg)
 
 
 def check_added(discs: Discs, box: Box, new_from: int, segments=(), pass_through=frozenset()) -> None:

@@ -56,4 +56,27 @@ def hexagonal_lattice():
     return ds.Discs(pts, v, 0.5), ds.Box(n, n * np.sqrt(3) / 2, periodic=True), list(range(n * n))
 
 
-JAMS = {f.__name__: f for f in (wall_and_obstacle, row_filling_the_box, between_two_obstacles, hexagonal_lattice)}
+def square_lattice_filling_a_periodic_box():
+    """A touching square lattice filling a periodic box (packing pi / 4), random velocities (issue 30, item 10).
+
+    Not rigid (whole rows and columns may slide), yet jammed for these velocities: each row is a ring of touching
+    discs as long as the box, so its discs cannot part along it; their x velocities differ, so some pair of each
+    ring always approaches, and equal discs swap velocities round the ring for ever at t = 0 (as do the columns'
+    y velocities). No elastic outcome exists: the rows' relative energy has nowhere to go.
+    """
+    n = 6
+    pts = np.array([[c + 0.5, r + 0.5] for r in range(n) for c in range(n)])
+    v = np.random.default_rng(1).normal(size=(n * n, 2))
+    return ds.Discs(pts, v, 0.5), ds.Box(n, n, periodic=True), list(range(n * n))
+
+
+JAMS = {
+    f.__name__: f
+    for f in (
+        wall_and_obstacle,
+        row_filling_the_box,
+        between_two_obstacles,
+        hexagonal_lattice,
+        square_lattice_filling_a_periodic_box,
+    )
+}

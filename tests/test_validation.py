@@ -71,6 +71,23 @@ def test_overlap_names_the_pair_and_depth():
         ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True))
 
 
+def test_a_crowd_of_overlapping_discs_is_an_overlap_error_not_a_memory_error():
+    """Issue 30, item 8: the overlap check of 10^5 discs at one spot asked numpy for 37 GiB (MemoryError)."""
+    n = 10**5
+    discs = ds.Discs(np.full((n, 2), 5.0), np.zeros((n, 2)), 0.01)
+    with pytest.raises(ds.OverlapError, match=r"discs 0 and 1 overlap by 0\.02 \(distance 0,"):
+        ds.EventDriven(discs, ds.Box(10.0, 10.0))
+    # The same discs spread over a periodic box, one pair overlapping far down the candidate pairs.
+    rng = np.random.default_rng(5)
+    side = 400.0
+    places = (np.stack(np.meshgrid(np.arange(316), np.arange(316)), -1).reshape(-1, 2) + 0.5) * (side / 316)
+    places = places[rng.permutation(len(places))]
+    places[-1] = places[-2] + [0.005, 0.0]
+    discs = ds.Discs(places, np.zeros_like(places), 0.5)
+    with pytest.raises(ds.OverlapError, match=f"discs {len(places) - 2} and {len(places) - 1} overlap by 0.995"):
+        ds.EventDriven(discs, ds.Box(side, side, periodic=True))
+
+
 def test_touching_discs_are_allowed():
     discs = ds.Discs([[2.0, 2.0], [3.0, 2.0]], [[1.0, 0.0], [0.0, 0.0]], 0.5)
     sim = ds.EventDriven(discs, ds.Box(10.0, 10.0))

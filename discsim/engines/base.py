@@ -239,6 +239,23 @@ class Engine(DiscEditing, EventRecord, SpatialQueries, ABC):
             )
             raise DiscsimError(msg)
 
+    def _check_can_advance(self) -> None:
+        """:meth:`_check_usable`, and refuse ``step()`` or ``run()`` from inside a run (an observer or a
+        ``sim.on`` callback), before anything changes: a ``run()`` there would serve the same callbacks again,
+        down to a ``RecursionError`` that left the engine marked broken.
+
+        Raises:
+            DiscsimError: as :meth:`_check_usable`.
+            InvalidArgumentError: inside a run.
+        """
+        self._check_usable()
+        if self.run_context.serving:
+            msg = (
+                "step() or run() inside a run is refused: an observer or a sim.on callback may not advance the "
+                "engine (observers may only look, callbacks may change discs); nothing was changed"
+            )
+            raise InvalidArgumentError(msg)
+
     def _settle(self, until: float) -> None:
         """Move the clock to ``until`` after a run that stopped on time."""
         self.time = until

@@ -9,7 +9,7 @@ private attributes.
 
 It lives beside the engines, not in ``run/``, because an engine exists (and is edited, saved, loaded)
 before any run and must hold one from its constructor on; the engine itself only reads ``log``,
-``recording``, ``streamed`` and the ids, and changes the ids when the user adds or removes discs.
+``recording``, ``serving``, ``streamed`` and the ids, and changes the ids when the user adds or removes discs.
 """
 
 from __future__ import annotations
@@ -42,6 +42,8 @@ class RunContext:
             changed (the engine's ``discs`` are then today's); None: the engine's ``discs`` and their indices.
         structure (int): ``add_discs`` / ``remove_discs`` calls so far (observers notice the disc set changed).
         handlers (dict[str, list]): the ``sim.on(kind, fn)`` callbacks by kind.
+        serving (bool): the driver is between two chunks of a run, serving its observers and callbacks; the
+            engine refuses ``step()`` and ``run()`` meanwhile (a callback may change discs, not advance them).
     """
 
     def __init__(self, n: int):
@@ -54,6 +56,7 @@ class RunContext:
         self.origin: tuple[Discs, np.ndarray | None] | None = None
         self.structure = 0
         self.handlers: dict[str, list] = {}
+        self.serving = False
 
     @property
     def streamed(self) -> bool:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, ClassVar, NoReturn
 
 import numpy as np
 
+from discsim.cells import neighbour_pair_chunks
 from discsim.engines.context import RunContext, readonly_ids
 from discsim.errors import DiscsimError, InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, _real_array
@@ -369,23 +370,38 @@ class DiscEditing:
                     raise OutsideBoxError(msg)
         places = np.array(self.positions)  # a writable copy
         places[idx] = positions
-        everyone = np.arange(len(radii))
-        for k, i in enumerate(idx.tolist()):
-            d = box.minimum_image(places - places[i])
-            dist = np.hypot(d[:, 0], d[:, 1])
-            contact = radii + radii[i]
-            depth = contact - dist
-            bad = depth > OVERLAP_TOLERANCE * contact
-            bad[i] = False
+        n = len(radii)
+        rank = np.full(n, n, dtype=np.int64)  # each moved disc's place in idx (n: not moved)
+        rank[idx] = np.arange(len(idx))
+        # The cell grid's candidate pairs that hold a moved disc, in pieces (O(N) work and memory, not O(K N)):
+        # every overlapping one, as (mover, other), until a pathological crowd has given 2^20 of them.
+        found: list[tuple[np.ndarray, ...]] = []
+        kept = 0
+        for i, j, d in neighbour_pair_chunks(places, 2.0 * float(radii.max()), box):
+            keep = (rank[i] < n) | (rank[j] < n)
             if self.scene.filtering:
-                bad &= ~self.scene.passes(np.full(len(radii), i), everyone)
-            if bad.any():
-                j = int(np.flatnonzero(bad)[np.argmax((depth / contact)[bad])])
-                msg = (
-                    f"disc {i} at {positions[k].tolist()} would overlap disc {j} by {depth[j]:.6g} "
-                    f"(distance {dist[j]:.6g}, contact distance {contact[j]:.6g})"
-                )
-                raise OverlapError(msg)
+                keep &= ~self.scene.passes(i, j)
+            i, j, d = i[keep], j[keep], d[keep]
+            contact = radii[i] + radii[j]
+            dist = np.hypot(d[:, 0], d[:, 1])
+            bad = contact - dist > OVERLAP_TOLERANCE * contact
+            i, j, contact, dist = i[bad], j[bad], contact[bad], dist[bad]
+            for mover, other in ((i, j), (j, i)):
+                moved = rank[mover] < n
+                found.append((mover[moved], other[moved], contact[moved], dist[moved]))
+                kept += int(moved.sum())
+            if kept > 1 << 20:
+                break
+        if kept:
+            mover, other, contact, dist = (np.concatenate(part) for part in zip(*found))
+            # The first disc of idx that overlaps, and its deepest overlap (the lowest index among equals).
+            first = int(np.lexsort((other, -(contact - dist) / contact, rank[mover]))[0])
+            i, j, k = int(mover[first]), int(other[first]), int(rank[mover[first]])
+            msg = (
+                f"disc {i} at {positions[k].tolist()} would overlap disc {j} by {contact[first] - dist[first]:.6g} "
+                f"(distance {dist[first]:.6g}, contact distance {contact[first]:.6g})"
+            )
+            raise OverlapError(msg)
 
 
 class Uneditable:

@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from discsim._interrupt import interrupted_outside_the_loop
 from discsim._validate import check_count, check_until, is_count
 from discsim.engines.base import provide
-from discsim.errors import InvalidArgumentError, TimeError
+from discsim.errors import Interrupted, InvalidArgumentError, TimeError
 from discsim.run.handlers import EventHandlers
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 
@@ -129,7 +130,7 @@ def drive(
         CheckpointError: if ``record_to`` or ``checkpoint`` names a foreign or damaged file.
             Nothing has been simulated then.
     """
-    engine._check_usable()
+    engine._check_can_advance()  # also refuses a run from inside a run (an observer or a callback)
     unit = engine.unit
     stop, limit = run_limits(until, limit, engine.time, unit, ends=engine.runs_to_end)
     if checkpoint_every is not None and (not is_count(checkpoint_every) or checkpoint_every == 0):
@@ -240,6 +241,7 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
     completed = False
     try:
         context.recording = wants_events  # the loop logs for the observers, whatever record says
+        context.serving = True  # step() and run() refused until the end
         try:
             for observer in chain:
                 observer.start(engine, plan)
@@ -270,8 +272,13 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
                 log.clear()
             mark = len(log)
             units = engine._units()
-            for observer in chain:
-                observer.update(engine, events, k, finishing)
+            try:
+                for observer in chain:
+                    observer.update(engine, events, k, finishing)
+            except Interrupted:
+                raise
+            except KeyboardInterrupt as exc:  # Ctrl-C in a slow callback: between two whole events, as Interrupted
+                raise interrupted_outside_the_loop() from exc
             if engine._units() != units:
                 msg = "an observer advanced the engine (step() or run() inside a run); observers may only look"
                 raise InvalidArgumentError(msg)
@@ -279,7 +286,7 @@ def _drive_chunks(engine, plan: RunPlan, chain: list[Observer], stream) -> int:
                 break
         completed = True
     finally:
-        context.recording = False
+        context.recording = context.serving = False
         for observer in reversed(started):
             observer.finish(engine, completed)
     return done

@@ -122,6 +122,27 @@ def test_groups_that_pass_through_may_be_added_overlapping(every_backend):
     assert groups.tolist() == [2, 2**62]  # the label's 64 bits, exactly
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_adding_a_crowd_of_overlapping_discs_is_an_overlap_error_in_bounded_memory(every_backend, engine):
+    """Issue 30, item 8: 10^5 discs at one spot made 5 10^9 candidate pairs at once (numpy's MemoryError,
+    37 GiB asked for); the check now goes through them in pieces and stops at the first overlap."""
+    import tracemalloc
+
+    sim = ENGINES[engine](ds.Discs([[1.0, 1.0]], [[0.0, 0.0]], 0.01), ds.Box(10.0, 10.0))
+    n = 10**5
+    crowd = ds.Discs(np.full((n, 2), 5.0), np.zeros((n, 2)), 0.01)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ds.OverlapError, match=r"new disc 2 at \[5\.0, 5\.0\] would overlap new disc 1 by 0\.02"):
+            sim.add_discs(crowd)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 400e6  # pieces of 2^20 pairs: about 100 MB
+    assert len(sim.discs) == 1  # nothing changed
+    sim.run(until=1.0)
+
+
 # --- exactness ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("periodic", [True, False])
 def test_after_a_change_the_run_is_a_fresh_engine_from_the_snapshot(every_backend, periodic):

@@ -222,3 +222,34 @@ def test_an_index_past_int64_is_named_as_given():
     sim = ds.EventDriven(*_gas(20))
     with pytest.raises(ds.InvalidArgumentError, match="disc index 18446744073709551615 does not exist"):
         sim.set_velocities([2**64 - 1], [[1.0, 0.0]])
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("periodic", [True, False])
+def test_set_positions_of_many_discs_checks_neighbours_only(every_backend, engine, periodic, monkeypatch):
+    """Issue 30, item 8's neighbour: set_positions measured each moved disc against every disc, O(K N) (10^4 discs
+    moved in a gas of 10^4: 11 s; 10^5: about 20 minutes). Now the cell grid's pairs: displacements of O(N) pairs."""
+    discs, box = ds.random_gas(2000, 0.3, periodic=periodic, seed=6)
+    sim = ENGINES[engine](discs, box)
+    rows = []
+    original = ds.Box.minimum_image
+
+    def counted(self, d):
+        rows.append(len(d))
+        return original(self, d)
+
+    monkeypatch.setattr(ds.Box, "minimum_image", counted)
+    everyone = np.arange(len(discs))
+    shifted = sim.positions * (1.0 - 1e-9)
+    sim.set_positions(everyone, shifted)
+    assert sum(rows) < 50 * len(discs)  # was len(discs) ** 2
+    np.testing.assert_array_equal(sim.positions, shifted)
+    # ... and an overlap is still found and named, deepest first, for the first disc given that has one.
+    crowd = shifted.copy()
+    crowd[7] = crowd[1500] + [0.01 * discs.radii[0], 0.0]
+    crowd[3] = crowd[1200] + [0.3 * discs.radii[0], 0.0]
+    with pytest.raises(ds.OverlapError, match=r"^disc 3 at .* would overlap disc 1200 by "):
+        sim.set_positions(everyone, crowd)
+    with pytest.raises(ds.OverlapError, match=r"^disc 1500 at .* would overlap disc 7 by 1\.99 "):
+        sim.set_positions(everyone[::-1], crowd[::-1])  # 1500 comes first now
+    np.testing.assert_array_equal(sim.positions, shifted)  # nothing changed

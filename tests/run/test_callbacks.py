@@ -76,3 +76,40 @@ def test_unknown_kinds_are_refused(kind):
         sim.on(kind, print)
     with pytest.raises(ds.InvalidArgumentError, match="callable"):
         sim.on("wall", 3)
+
+
+NESTED = {
+    "run(events=3)": lambda sim: sim.run(events=3),
+    "run(until=)": lambda sim: sim.run(until=sim.time + 1.0),
+    "step()": lambda sim: sim.step(),
+}
+
+
+@pytest.mark.parametrize("nested", sorted(NESTED))
+@pytest.mark.parametrize("how", ["sim.on", "observer"])
+def test_a_callback_that_advances_the_engine_is_refused_before_anything_changes(every_backend, nested, how):
+    """Issue 30, item 9: ``sim.run(events=3)`` in a ``sim.on`` callback served the same callbacks again, down to a
+    RecursionError that left the engine marked broken; in an observer it (and ``step()``) ran before the driver
+    noticed. Now each is refused at once: nothing changes, and the run goes on exactly."""
+    discs, box = ds.random_gas(30, 0.3, seed=3)
+    reference = ds.EventDriven(discs, box).run(until=5.0)
+    sim = ds.EventDriven(discs, box)
+    seen = []
+
+    def advance(s, *_):
+        seen.append((s.time, s.counts, s.positions.tobytes()))
+        NESTED[nested](s)
+
+    with pytest.raises(ds.InvalidArgumentError, match=r"step\(\) or run\(\) inside a run is refused"):
+        if how == "sim.on":
+            sim.on("collision", advance).run(until=5.0)
+        else:
+            sim.run(until=5.0, observers=[ds.Callback(advance, every=1)])
+    assert len(seen) == 1 and sim._broken is None
+    time, counts, positions = seen[0]
+    assert (sim.time, sim.counts, sim.positions.tobytes()) == (time, counts, positions)  # nothing changed
+    sim._check()
+    sim.run_context.handlers.clear()
+    sim.run(until=5.0)
+    assert sim.positions.tobytes() == reference.positions.tobytes()
+    assert sim.events.tobytes() == reference.events.tobytes()

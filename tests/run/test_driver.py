@@ -192,7 +192,7 @@ def test_resuming_without_the_runs_log_is_refused(tmp_path):
 
 def test_observers_may_not_advance_the_engine(make):
     sim = make()
-    with pytest.raises(ds.InvalidArgumentError, match="advanced the engine"):
+    with pytest.raises(ds.InvalidArgumentError, match="advance the engine"):
         sim.run(until=2.0, observers=[ds.Callback(lambda s, e: s.step(), every=5)])
 
 

@@ -219,7 +219,8 @@ class EventDriven(RunStops, Engine):
             unwrapped = old.unwrapped_positions()[keep]
             state.images[: len(keep)] = image_steps(unwrapped, scene.discs.positions[: len(keep)], box.size)
         backend.start(state)
-        self.grid, self._backend, self._jam_mark = grid, backend, None
+        self.grid, self._backend = grid, backend
+        self._jam_mark = self._jam_counts = self._jam_scale = None  # new discs: the jam guard starts afresh
 
     # --- the user's protocol -------------------------------------------------------------
     @property
@@ -308,7 +309,7 @@ class EventDriven(RunStops, Engine):
             pair drifts alike, or moves relative to itself only along x or only
             along y and misses; see :meth:`_never_again`).
         """
-        self._check_usable()
+        self._check_can_advance()
         if self._advance(INF, 1) == 0:
             return None
         last = self._backend.last_event()

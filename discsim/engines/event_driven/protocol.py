@@ -65,6 +65,10 @@ class Backend(Protocol):
     def counts(self) -> dict[str, int]:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
 
+    def disc_counts(self) -> np.ndarray:
+        """``(N,)`` int64: each disc's collision counter (its collisions, wall hits and edits so far; obstacles'
+        stay put), a new array in the caller's numbering. O(N): the jam guard's, once per suspected jam."""
+
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, not wrapped."""
 

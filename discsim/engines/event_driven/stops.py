@@ -41,6 +41,8 @@ class RunStops:
     scene: Scene
     time: float
 
+    _edits: int
+
     if TYPE_CHECKING:  # the engine's own methods, named for the type checker only (at run time they would
         # come before the engine's in the method order)
 
@@ -110,18 +112,31 @@ class RunStops:
         self._restructure(np.arange(len(now)), None, scene, last)
 
     #: A run raises :class:`~discsim.errors.JammedError` after ``jam_events + jam_events_per_disc * N``
-    #: physical events in a row at one instant: far more than a finite cascade of simultaneous collisions
-    #: (``N (N - 1) / 2`` at most for a touching row), while wedged discs collide there for ever.
+    #: physical events in a row at one instant (or within ``jam_time`` of the time scale, below), plus room for
+    #: the longest finite cascade the touching discs could make (:meth:`_cascade`): wedged discs collide there
+    #: for ever, while a finite cascade of simultaneous collisions ends (``M (M - 1) / 2`` collisions at most for
+    #: a touching row of M discs of one mass, ``M (sqrt(M) - 1)`` for a touching square lattice with room).
     jam_events: int = 10_000
     jam_events_per_disc: int = 100
-    _jam_mark: tuple[float, int] | None = None  # (time, physical events) when the clock was last seen there
+    #: ... and those events count as "at one instant" while the clock moves by less than ``jam_time`` times the
+    #: time scale ``sqrt(sum m r^2 / sum m v^2)`` (discs of finite mass: the time a disc at the mass-weighted
+    #: rms speed takes to cross its radius): an unbounded cascade creeps towards an instant it never reaches
+    #: (a light disc squeezed between a wall and a disc 10^200 times heavier: its speed grows by twice the
+    #: heavy one's at each of some 10^100 bounces). A free gas takes about 100 collision times per disc for
+    #: that many events, so only discs closer than about 10^-10 radii to wedged, for ever, qualify.
+    jam_time: float = 1e-8
+    _jam_mark: tuple[float, int, int, bool] | None = None  # (time, physical events, events allowed, extended)
+    _jam_counts: tuple[int, np.ndarray] | None = None  # (physical events, each disc's counter) half-way there
+    _jam_scale: tuple[int, int, float] | None = None  # (edits, physical events, time scale) when last taken
 
     def _chunked(self, until: float, limit: int | None, log, crossings: int | None = None) -> int:
         """``backend.advance(until, limit, log, crossings)`` in chunks, watching the clock between them.
 
         The same result as one call (chunks change nothing in the dynamics), for every backend. Each chunk
-        holds at most the jam threshold of physical events; when that many pass, over any number of calls
-        (a driver's chunks, ``step()`` after ``step()``), with the clock standing still, the discs are jammed.
+        holds at most half the jam threshold of physical events; when that many pass, over any number of
+        calls (a driver's chunks, ``step()`` after ``step()``), with the clock standing still (or moving by
+        less than ``jam_time`` of the time scale), the discs are jammed. Half-way there the discs' counters
+        are taken, so that the error names the discs the cascade moved.
 
         Raises:
             JammedError: naming the jammed discs; the engine is consistent at its last whole event.
@@ -130,17 +145,24 @@ class RunStops:
         chunk = self.jam_events + self.jam_events_per_disc * len(self.discs)
         done, left = 0, crossings
         while True:
-            ask = chunk if limit is None else min(chunk, limit - done)
-            if self._jam_mark is None or self._jam_mark[0] != backend.time:
-                self._jam_mark = (backend.time, self._units())
+            window = self.jam_time * self._time_scale(chunk)
+            mark, units = self._jam_mark, self._units()
+            if mark is None or backend.time - mark[0] > window:
+                mark = self._jam_mark = (backend.time, units, chunk, False)
+                self._jam_counts = None
+            seen, half = units - mark[1], mark[2] // 2
+            room = half - seen if seen < half else mark[2] - seen  # stop half-way, and at the threshold
+            ask = room if limit is None else min(room, limit - done)
             crossed = backend.counts()["cell_crossings"] if crossings is not None else 0
             k = backend.advance(until, ask, log, left)
             done += k
             units = self._units()
-            if backend.time != self._jam_mark[0]:
-                self._jam_mark = (backend.time, units)
-            elif units - self._jam_mark[1] >= chunk:
-                raise JammedError(self._jam_message(units - self._jam_mark[1]))
+            if backend.time - mark[0] > window:
+                self._jam_mark, self._jam_counts = (backend.time, units, chunk, False), None
+            elif units - mark[1] >= mark[2]:
+                self._jammed(mark, units, chunk)
+            elif units - mark[1] >= half and self._jam_counts is None:
+                self._jam_counts = (units, backend.disc_counts())
             if k < ask or done == limit:
                 return done  # the time or event limit, an empty queue, or the crossings asked for
             if left is not None:
@@ -148,39 +170,102 @@ class RunStops:
                 if left <= 0:
                     return done
 
-    def _jammed_discs(self) -> np.ndarray:
-        """The discs of the last event and every disc touching them, transitively (sorted, caller's numbering).
+    def _jammed(self, mark: tuple[float, int, int, bool], units: int, chunk: int) -> None:
+        """The threshold is reached: give a finite cascade of the touching discs its room once, else raise (or
+        start afresh, when the time scale taken now, after the user's edits, says that the clock did move)."""
+        scale = self._time_scale(chunk, fresh=True)
+        if self.time - mark[0] > self.jam_time * scale:
+            self._jam_mark, self._jam_counts = (self.time, units, chunk, False), None
+            return
+        discs, room = self._cascade()
+        if not mark[3] and room > 0:
+            self._jam_mark = (mark[0], mark[1], mark[2] + room, True)
+            return
+        raise JammedError(self._jam_message(discs, units - mark[1], self.time - mark[0], scale))
 
-        Touching: centres within the contact distance plus 1e-9 of it, minimum image, collision filter obeyed.
+    def _time_scale(self, chunk: int, fresh: bool = False) -> float:
+        """``sqrt(sum m r^2 / sum m v^2)`` over the discs of finite mass (0.0 when none moves).
+
+        O(N) to take, so kept (elastic collisions keep the energy) until the user's edits changed the discs and
+        ``chunk / 2`` physical events passed since (a callback that edits after every event costs O(N) per
+        ``chunk / 2`` events, not per event), or when asked ``fresh`` (before a :class:`JammedError`).
+        """
+        kept = self._jam_scale
+        if kept is not None and not fresh and (kept[0] == self._edits or self._units() - kept[1] < chunk // 2):
+            return kept[2]
+        masses, radii = self.discs.masses, self.discs.radii
+        finite = np.isfinite(masses)
+        scale = 0.0
+        if finite.any():
+            weight = masses[finite] / masses[finite].max()  # no overflow: masses reach 1e100, speeds too
+            speed2 = (self.velocities[finite] ** 2).sum(axis=1)
+            energy = float(weight @ speed2)
+            if energy > 0.0:
+                scale = math.sqrt(float(weight @ radii[finite] ** 2) / energy)
+        self._jam_scale = (self._edits, self._units(), scale)
+        return scale
+
+    def _cascade(self) -> tuple[np.ndarray, int]:
+        """The discs of a suspected jam, and the room a finite cascade of theirs might still need.
+
+        The discs: those of the last event and those the cascade moved (their counters changed since half-way
+        to the threshold), and every disc touching them, transitively (sorted, caller's numbering). Touching:
+        centres within the contact distance plus 1e-9 of it, minimum image, collision filter obeyed.
+
+        The room: ``M e`` events, with ``M`` the moving discs touching the last event's disc through moving
+        discs, transitively, and ``e`` the most contacts from that disc to another of them (``e`` is at least
+        half the contacts across the cluster, ``D``): a touching row or square lattice of discs of one mass,
+        with room around it, ends its cascade within ``M D / 2`` collisions (each row and each column sorts its
+        velocities). Obstacles pass no velocity on: they are not counted, nor crossed.
         """
         last = self._backend.last_event()
         if last is None:
-            return np.zeros(0, dtype=np.int64)
-        seeds = [d for d in last[2:] if d >= 0]
+            return np.zeros(0, dtype=np.int64), 0
         n = len(self.discs)
-        radii = self.discs.radii
+        radii, masses = self.discs.radii, self.discs.masses
         i, j, d = neighbour_pairs(self.positions, 2.0 * float(radii.max()), self.box)
         touch = np.hypot(d[:, 0], d[:, 1]) <= (radii[i] + radii[j]) * (1.0 + 1e-9)
         if self.scene.filtering:
             touch &= ~self.scene.passes(i, j)
         i, j = i[touch], j[touch]
-        jammed = np.zeros(n, dtype=bool)
-        jammed[seeds] = True
-        while True:  # grow the touching cluster around the last event's discs
-            grown = jammed.copy()
-            grown[j[jammed[i]]] = True
-            grown[i[jammed[j]]] = True
-            if grown.sum() == jammed.sum():
-                return np.flatnonzero(jammed)
-            jammed = grown
 
-    def _jam_message(self, events: int) -> str:
-        discs = self._jammed_discs().tolist()
-        named = ", ".join(map(str, discs[:20])) + (f", ... ({len(discs)} discs)" if len(discs) > 20 else "")
+        def grow(seeds: np.ndarray, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, int]:
+            """The cluster of contacts ``(i, j)`` around ``seeds`` (a mask) and the steps it took."""
+            steps = 0
+            while True:
+                grown = seeds.copy()
+                grown[j[seeds[i]]] = True
+                grown[i[seeds[j]]] = True
+                if grown.sum() == seeds.sum():
+                    return seeds, steps
+                seeds, steps = grown, steps + 1
+
+        first = np.zeros(n, dtype=bool)
+        first[last[2]] = True  # a moving disc: the owner of the event
+        moving = np.isfinite(masses[i]) & np.isfinite(masses[j])  # obstacles pass no velocity on
+        cluster, reach = grow(first, i[moving], j[moving])
+        room = int(cluster.sum()) * reach
+        seeds = first.copy()
+        seeds[[k for k in last[2:] if k >= 0]] = True
+        if self._jam_counts is not None:
+            seeds |= self._backend.disc_counts() != self._jam_counts[1]
+        return np.flatnonzero(grow(seeds, i, j)[0]), room
+
+    def _jam_message(self, discs: np.ndarray, events: int, moved: float, scale: float) -> str:
+        listed = discs.tolist()
+        named = ", ".join(map(str, listed[:20])) + (f", ... ({len(listed)} discs)" if len(listed) > 20 else "")
+        if moved == 0.0:
+            return (
+                f"discs {named} are jammed at time {self.time!r}: wedged against each other or a wall, they made "
+                f"{events} collisions and wall hits without the clock moving; give them room (a gap) or velocities "
+                "that part them"
+            )
         return (
-            f"discs {named} are jammed at time {self.time!r}: wedged against each other or a wall, they made "
-            f"{events} collisions and wall hits without the clock moving; give them room (a gap) or velocities "
-            "that part them"
+            f"discs {named} are jammed at time {self.time!r}: squeezed against each other or a wall, they made "
+            f"{events} collisions and wall hits while the clock moved by {moved:.3g}, under jam_time = "
+            f"{self.jam_time:g} of the time a disc takes to cross its radius ({scale:.3g}): a cascade "
+            "that would go on for ever (a light disc squeezed between a wall and a far heavier disc, say); give "
+            "them room, or masses closer to each other's"
         )
 
     def _never_again(self) -> bool:

@@ -415,7 +415,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             >>> sim.velocities.tolist()
             [[-2.0, 0.0]]
         """
-        self._check_usable()
+        self._check_can_advance()
         return self._frame()
 
     def _frame(self) -> list[Event]:

@@ -333,6 +333,12 @@ class NumbaBackend:
             "predictions": int(ints[lp.I_PRED]),
         }
 
+    def disc_counts(self) -> np.ndarray:
+        """``(N,)`` each disc's collision counter, in the caller's numbering (a new array)."""
+        out = np.empty(len(self._order), dtype=np.int64)
+        out[self._order] = self._count
+        return out
+
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, not wrapped."""
         t = self.time - float(self._floats[self._lp.F_EPOCH])

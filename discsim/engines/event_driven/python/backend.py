@@ -307,6 +307,12 @@ class PythonBackend:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
         return {**self._counts, "predictions": self._predictions()}
 
+    def disc_counts(self) -> np.ndarray:
+        """``(N,)`` each disc's collision counter, in the caller's numbering (a new array)."""
+        out = np.empty(len(self._order), dtype=np.int64)
+        out[self._order] = self._count
+        return out
+
     @property
     def virial(self) -> float:
         """Sum over collisions of ``dp_i . (r_i - r_j)`` since the start (for the pressure)."""

@@ -76,6 +76,10 @@ class CheckpointError(DiscsimError, ValueError):
     """A checkpoint or event-log file that is damaged, foreign or incompatible."""
 
 
+class CacheWarning(UserWarning):
+    """A sweep's cache entry that was damaged or changed: reported, not served, and computed again."""
+
+
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C stopped a run at the end of a whole event (or frame): the engine is consistent and can go on.
 

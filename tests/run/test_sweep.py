@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -109,9 +110,41 @@ def test_cache_entry_that_cannot_be_read_is_computed_again(tmp_path):
     first = ds.sweep(sweep_tasks.draw, {"a": [1.0, 2.0]}, workers=0, cache=cache)
     entry = sorted(cache.glob("??/*.json"))[0]
     entry.write_text('{"key": "trunc')
-    again = ds.sweep(sweep_tasks.draw, {"a": [1.0, 2.0]}, workers=0, cache=cache)
+    with pytest.warns(ds.CacheWarning, match=f"{entry.name}.*cannot be read"):
+        again = ds.sweep(sweep_tasks.draw, {"a": [1.0, 2.0]}, workers=0, cache=cache)
     pd.testing.assert_frame_equal(again, first)
     assert again.attrs["sweep"]["ran"] == 1 and again.attrs["sweep"]["cached"] == 1
+
+
+def test_a_cache_entry_changed_by_hand_is_reported_and_computed_again_never_served(tmp_path):
+    cache = tmp_path / "c"
+    first = ds.sweep(sweep_tasks.fails_at, {"a": [1, 3]}, workers=0, cache=cache)
+    entries = sorted(cache.glob("??/*.json"))
+    changed = next(e for e in entries if '"twice":2' in e.read_text())
+    changed.write_text(changed.read_text().replace('"twice":2', '"twice":4'))  # "y": 1.0 to 2.0, by hand
+    with pytest.warns(ds.CacheWarning, match=f"{changed.name}.*does not match its checksum"):
+        again = ds.sweep(sweep_tasks.fails_at, {"a": [1, 3]}, workers=0, cache=cache)
+    pd.testing.assert_frame_equal(again, first)
+    assert again.twice.tolist() == [2, 6] and again.attrs["sweep"]["ran"] == 1
+    assert '"twice":2' in changed.read_text()  # recomputed and stored again: served from now on, silently
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert ds.sweep(sweep_tasks.fails_at, {"a": [1, 3]}, workers=0, cache=cache).attrs["sweep"]["ran"] == 0
+
+
+def test_a_cache_entry_with_another_tasks_identity_or_no_checksum_is_not_served(tmp_path):
+    cache = tmp_path / "c"
+    ds.sweep(sweep_tasks.fails_at, {"a": [1, 3]}, workers=0, cache=cache)
+    one, three = sorted(cache.glob("??/*.json"), key=lambda e: '"twice":2' not in e.read_text())
+    three.write_bytes(one.read_bytes())  # a whole, self-consistent entry, but another task's
+    entry = json.loads(one.read_text())
+    del entry["checksum"]
+    one.write_text(json.dumps(entry))
+    with pytest.warns(ds.CacheWarning) as caught:
+        again = ds.sweep(sweep_tasks.fails_at, {"a": [1, 3]}, workers=0, cache=cache)
+    assert again.twice.tolist() == [2, 6] and again.attrs["sweep"]["ran"] == 2
+    messages = " ".join(str(w.message) for w in caught)
+    assert one.name in messages and three.name in messages
 
 
 def test_version_is_part_of_the_key(tmp_path, monkeypatch):

@@ -14,8 +14,13 @@ results in a tidy table (a pandas DataFrame). It brings no scheduler of its own:
   missing.
 - **Failures.** A task that raises is run again, up to ``retries`` more times; if it still fails, the sweep
   finishes the others, and the table keeps its row with the error (``error`` column) while
-  ``table.attrs["failures"]`` holds its parameters, seed, error, traceback and attempts. A worker that dies
-  (or a cluster that loses it) counts as a failed attempt of the tasks it held.
+  ``table.attrs["failures"]`` holds its parameters, seed, error, traceback and attempts. A local worker
+  that dies (``os._exit``, a crash, a kill) counts a failed attempt (``WorkerDied``, naming the parameters)
+  of the task it was running, and of no other: the pool is started again and the other tasks it held are
+  sent again. On dask, the cluster decides (it retries tasks whose worker it lost, then reports them).
+- **Stopping.** Ctrl-C stops the local pool's workers (a hung task included) and raises
+  :class:`~discsim.errors.Interrupted` at once; the workers ignore Ctrl-C themselves (no tracebacks of
+  theirs). A worker whose sweep is killed (kill -9) exits too, instead of waiting for tasks forever.
 - **Determinism.** The table does not depend on where, in which order or how many at a time the tasks ran:
   rows are in grid order (the last parameter varying fastest), then seed order, and wall-clock figures are
   kept out of it (they are in ``table.attrs["sweep"]``).
@@ -343,39 +348,234 @@ class _Finished:
                 continue
 
 
+#: Seconds between a worker's checks that the sweep that started it is still alive.
+PARENT_CHECK_SECONDS = 0.5
+#: Deaths of workers outside any task that a pool survives before the tasks it holds count as failed.
+UNATTRIBUTED_DEATHS = 3
+
+
+def _worker_start(parent: int) -> None:
+    """Set up a worker of the local pool (its initializer): it ignores Ctrl-C and dies with its sweep.
+
+    Ctrl-C in a terminal reaches every process of the group: the sweep stops its workers itself, so that
+    they print no traceback. A worker whose sweep died (kill -9) would wait for tasks forever: on Linux the
+    kernel kills it (``PR_SET_PDEATHSIG``), elsewhere a thread of its own sees its parent change and exits.
+    """
+    import signal
+    import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass  # the thread below does it
+    if os.getppid() != parent:  # the sweep died while this worker started
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(PARENT_CHECK_SECONDS)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="discsim-sweep-parent-watch", daemon=True).start()
+
+
+def _attempt_marked(marks: str, token: int, task, params: dict, seed: int):
+    """:func:`attempt` in a worker of the local pool, with a file in ``marks`` while the task runs.
+
+    A worker that dies leaves its task's mark behind: that tells the sweep which task was running.
+    """
+    mark = os.path.join(marks, str(token))
+    with open(mark, "w"):
+        pass
+    try:
+        return attempt(task, params, seed)
+    finally:
+        try:
+            os.unlink(mark)
+        except OSError:
+            pass
+
+
+class _Attempt:
+    """One attempt of a task on the local pool, whichever pool (and future) runs it now."""
+
+    future: Future  # set when it is sent to a pool, as is:
+    pool: ProcessPoolExecutor
+
+    def __init__(self, token: int, args: tuple):
+        self.token = token
+        self.args = args
+        self.outcome: tuple | None = None
+
+    def result(self):
+        return self.outcome
+
+
 class _LocalPool(_Finished):
-    """A process pool on this machine (``fork`` on Linux, so tasks defined in a notebook or script run)."""
+    """A process pool on this machine (``fork`` on Linux, so tasks defined in a notebook or script run).
+
+    A worker that dies (``os._exit``, a crash, the kernel's OOM killer) breaks a
+    ``ProcessPoolExecutor``: every task it holds fails with ``BrokenProcessPool``. Here only the task that
+    was running in the dead worker counts a failed attempt; the others are sent again to a new pool, as if
+    nothing happened. Each worker marks (a file in a temporary folder) the task it runs, so after a break
+    the tasks that were running are known: when only one was, it is the one. When several were (one per
+    busy worker), the dead one is not known: those tasks run again one at a time on a pool of one worker,
+    where a death can only be the running task's.
+    """
 
     def __init__(self, workers: int):
         super().__init__()
         self.workers = workers
         self.label = f"{workers} local process{'es' if workers > 1 else ''}"
-        self._pool: ProcessPoolExecutor | None = None
+        self._pools: dict[bool, ProcessPoolExecutor] = {}  # solo (one worker, for suspects) -> its pool
+        self._marks: str | None = None
+        self._tokens = itertools.count()
+        self._running: dict[Future, _Attempt] = {}
+        self._ready: list[_Attempt] = []  # attempts whose outcome is known without their future (a death)
+        self._unattributed = 0  # deaths outside any task
 
-    def _executor(self) -> ProcessPoolExecutor:
-        if self._pool is None:
+    def _executor(self, solo: bool = False) -> ProcessPoolExecutor:
+        pool = self._pools.get(solo)
+        if pool is None:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
 
             context = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
-            self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=context)
-        return self._pool
+            pool = ProcessPoolExecutor(
+                max_workers=1 if solo else self.workers,
+                mp_context=context,
+                initializer=_worker_start,
+                initargs=(os.getpid(),),
+            )
+            self._pools[solo] = pool
+        return pool
+
+    def _marks_folder(self) -> str:
+        if self._marks is None:
+            import tempfile
+
+            self._marks = tempfile.mkdtemp(prefix="discsim-sweep-")
+        return self._marks
 
     def submit(self, *args):
+        job = _Attempt(next(self._tokens), args)
+        self._send(job, solo=False)
+        return job
+
+    def _send(self, job: _Attempt, solo: bool) -> None:
         from concurrent.futures.process import BrokenProcessPool
 
-        pool = self._executor()
-        try:
-            return self.track(pool.submit(attempt, *args))
-        except BrokenProcessPool:  # a worker died: a new pool for what is left
-            pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
-            return self.track(self._executor().submit(attempt, *args))
+        for _ in range(2):
+            pool = self._executor(solo)
+            try:
+                future = pool.submit(_attempt_marked, self._marks_folder(), job.token, *job.args)
+            except BrokenProcessPool:  # it broke since: its tasks come back through next_done; a new pool here
+                self._pools.pop(solo, None)
+                pool.shutdown(wait=False, cancel_futures=True)
+                continue
+            job.future, job.pool = future, pool
+            self._running[future] = job
+            self.track(future)
+            return
+        msg = "the local process pool breaks as soon as it starts"
+        raise RuntimeError(msg)
+
+    def next_done(self):
+        from concurrent.futures.process import BrokenProcessPool
+
+        while True:
+            if self._ready:
+                return self._ready.pop(0)
+            future = super().next_done()
+            job = self._running.pop(future, None)
+            if job is None:
+                continue  # a task of a broken pool, already sent again
+            if isinstance(future.exception(), BrokenProcessPool):
+                self._broken(job)
+                continue
+            job.outcome = _outcome(future)
+            return job
+
+    def _broken(self, first: _Attempt) -> None:
+        """A worker of ``first``'s pool died: find the task it ran, send the others again."""
+        import concurrent.futures
+
+        pool = first.pool
+        held = [first, *(job for job in self._running.values() if job.pool is pool)]
+        for job in held[1:]:
+            del self._running[job.future]
+        concurrent.futures.wait([job.future for job in held], timeout=10.0)  # the pool fails them all at once
+        for solo, kept in list(self._pools.items()):
+            if kept is pool:
+                del self._pools[solo]
+        pool.shutdown(wait=False, cancel_futures=True)
+        marks = self._marks_folder()
+        started = [job for job in held if os.path.exists(os.path.join(marks, str(job.token)))]
+        for job in started:
+            os.unlink(os.path.join(marks, str(job.token)))
+        if len(started) == 1:
+            (dead,) = started
+            params, seed = dead.args[1], dead.args[2]
+            error = (
+                f"WorkerDied: the worker process died while running the task {params}, seed={seed} (it ended "
+                f"without an exception: os._exit, a crash, or a kill, such as the kernel's when memory runs out)"
+            )
+            dead.outcome = ("error", error, f"{error}\n(no traceback: the process ended at once)\n", float("nan"))
+            self._ready.append(dead)
+            for job in held:
+                if job is not dead:
+                    self._send(job, solo=False)
+            return
+        if started:  # one of them died, the others were stopped with it: each runs again alone
+            for job in held:
+                self._send(job, solo=job in started)
+            return
+        self._unattributed += 1  # a worker died between tasks (or before it could mark one)
+        if self._unattributed < UNATTRIBUTED_DEATHS:
+            for job in held:
+                self._send(job, solo=False)
+            return
+        for job in held:
+            params, seed = job.args[1], job.args[2]
+            error = (
+                f"WorkerDied: the pool's worker processes died {self._unattributed} times outside any task; the "
+                f"task {params}, seed={seed} was waiting"
+            )
+            job.outcome = ("error", error, f"{error}\n", float("nan"))
+            self._ready.append(job)
 
     def close(self, cancel: bool = False) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=not cancel, cancel_futures=cancel)
-            self._pool = None
+        import shutil
+
+        pools, self._pools = list(self._pools.values()), {}
+        for pool in pools:
+            if cancel:
+                _stop_workers(pool)
+            pool.shutdown(wait=not cancel, cancel_futures=cancel)
+        self._running.clear()
+        self._ready.clear()
+        if self._marks is not None:
+            shutil.rmtree(self._marks, ignore_errors=True)
+            self._marks = None
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Kill the worker processes of ``pool`` and reap them: a hung task must not keep the sweep alive."""
+    kill = getattr(pool, "kill_workers", None)  # Python 3.14
+    if kill is not None:
+        kill()
+        return
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # no public list before 3.14
+    for process in processes:
+        process.kill()
+    for process in processes:
+        process.join(timeout=5.0)
 
 
 class _Dask(_Finished):
@@ -463,7 +663,8 @@ def sweep(
             run twice, and a killed sweep resumes where it stopped. None: no cache. The key holds the
             task's name and discsim's version, not their code: after changing the task (or discsim
             without a new version), give the sweep a new folder, or its old results are served.
-        retries: more attempts for a task that raised (or whose worker died) before it counts as failed.
+        retries: more attempts for a task that raised (or whose worker died while running it) before it
+            counts as failed.
         progress: show a bar over the tasks (tqdm when installed).
 
     Returns:
@@ -482,7 +683,8 @@ def sweep(
             or a cache folder that holds another task's results or files of its own.
         WrongTypeError: if ``task`` is not callable, ``grid`` is neither a dict nor a list, or ``client``
             is not a dask client.
-        Interrupted: on Ctrl-C, after the pool is stopped; every finished result is in the cache.
+        Interrupted: on Ctrl-C, after the pool's workers are stopped (a hung task too); every finished
+            result is in the cache.
 
     Example:
         >>> import discsim as ds

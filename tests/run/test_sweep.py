@@ -187,12 +187,25 @@ def test_failures_are_not_cached_and_run_again(tmp_path):
     assert table.twice.tolist() == [2] and table.attrs["sweep"]["ran"] == 1
 
 
-def test_a_worker_that_dies_fails_its_tasks_and_the_pool_is_restarted():
-    with pytest.warns(RuntimeWarning):
-        table = ds.sweep(sweep_tasks.dies, {"a": [0, 1, 2, 3]}, workers=1, retries=1)
-    failed = table[table.error.notna()]
-    assert 1 in failed.a.tolist() and "worker running the task was lost" in failed.error.iloc[0]
-    assert table[table.error.isna()].a2.tolist() == [a * a for a in table[table.error.isna()].a]
+def test_a_worker_that_dies_fails_only_its_own_task_and_the_others_finish():
+    with pytest.warns(RuntimeWarning, match="1 of 8 tasks failed after 2 attempt"):
+        table = ds.sweep(sweep_tasks.dies, {"a": list(range(8))}, workers=1, retries=1)
+    assert table.error.notna().tolist() == [a == 1 for a in range(8)]
+    assert table.a2.drop(index=1).tolist() == [a * a for a in range(8) if a != 1]
+    (failure,) = table.attrs["failures"]
+    assert failure["params"] == {"a": 1} and failure["attempts"] == 2
+    assert failure["error"].startswith("WorkerDied: the worker process died while running the task {'a': 1}, seed=")
+    assert table.attrs["sweep"]["retries"] == 1
+
+
+@pytest.mark.slow
+def test_a_worker_that_dies_beside_busy_workers_fails_only_its_own_task():
+    grid = {"a": list(range(8)), "pause": 0.3}  # a = 0 and a = 1 start together: both are running when 1 dies
+    with pytest.warns(RuntimeWarning, match="1 of 8 tasks failed after 1 attempt"):
+        table = ds.sweep(sweep_tasks.dies_beside_others, grid, workers=2)
+    assert table.error.notna().tolist() == [a == 1 for a in range(8)]
+    assert table.a2.drop(index=1).tolist() == [a * a for a in range(8) if a != 1]
+    assert "'a': 1" in table.error[1] and table.attrs["failures"][0]["attempts"] == 1
 
 
 def test_many_tasks_on_the_pool_each_reported_once():
@@ -212,6 +225,76 @@ def test_ctrl_c_stops_the_sweep_and_keeps_what_finished(tmp_path):
     with pytest.raises(ds.Interrupted, match="2 of 5 tasks unfinished; the 3 finished are in the cache"):
         ds.sweep(sweep_tasks.interrupts, {"a": [0, 1, 2, 3, 4]}, workers=0, cache=cache)
     assert len(list(cache.glob("??/*.json"))) == 3
+
+
+def _alive(pid: int) -> bool:
+    """Whether the process ``pid`` runs (a zombie, dead but not yet reaped, counts as gone)."""
+    stat = Path(f"/proc/{pid}/stat")
+    if stat.parent.parent.is_dir() and Path("/proc/self").exists():
+        try:
+            return stat.read_text().rsplit(")", 1)[1].split()[0] != "Z"
+        except OSError:
+            return False
+    try:
+        os.kill(pid, 0)
+    except OSError:
+        return False
+    return True
+
+
+def _worker_pids(folder: Path, count: int, child, timeout: float = 60.0) -> list[int]:
+    """The pids that ``count`` tasks of :func:`sweep_tasks.hangs` wrote into ``folder`` (waits for them)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and child.poll() is None:
+        texts = [p.read_text() for p in folder.iterdir()]
+        if len(texts) >= count and all(texts):
+            return sorted({int(t) for t in texts})
+        time.sleep(0.05)
+    pytest.fail(f"the sweep's tasks did not start (exit code {child.poll()})")
+
+
+def _stop(pids) -> None:
+    """Kill what a failed test left running (the pids its own sweep's tasks reported)."""
+    for pid in pids:
+        if _alive(pid):
+            os.kill(pid, signal.SIGKILL)
+
+
+HANGS = """
+import sys
+import discsim as ds, sweep_tasks
+try:
+    ds.sweep(sweep_tasks.hangs, {{"a": [0, 1, 2], "pids": {pids!r}}}, workers=2)
+except ds.Interrupted as exc:
+    print("interrupted:", exc, flush=True)
+    sys.exit(130)
+"""
+
+
+@pytest.mark.slow
+def test_ctrl_c_with_a_task_hung_stops_the_workers_and_returns_promptly(tmp_path):
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
+    child = subprocess.Popen(
+        [sys.executable, "-c", HANGS.format(pids=str(pids))], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    workers = _worker_pids(pids, 2, child)
+    try:
+        time.sleep(0.3)
+        os.kill(child.pid, signal.SIGINT)  # Ctrl-C to the sweep's process alone
+        start = time.monotonic()
+        out, err = child.communicate(timeout=10)
+        assert time.monotonic() - start < 3.0, "Ctrl-C took more than 3 s to stop the sweep"
+        assert child.returncode == 130, err
+        assert b"interrupted: sweep interrupted with 2 of 3 tasks unfinished" in out
+        deadline = time.monotonic() + 5.0
+        while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(_alive(p) for p in workers), "the pool's workers outlived the sweep"
+    finally:
+        child.kill()
+        _stop(workers)
 
 
 # --- bad input: a clear error before any task runs ---------------------------------------------------------
@@ -356,6 +439,62 @@ def test_cli_sweep_killed_half_way_resumes_running_only_the_missing_tasks(tmp_pa
     whole = _cli(["sweep", spec, "--out", tmp_path / "whole", "--workers", "2", "--no-progress"], capture_output=True)
     assert whole.returncode == 0
     assert (out / "sweep.csv").read_text() == (tmp_path / "whole" / "sweep.csv").read_text()
+
+
+@pytest.mark.slow
+def test_cli_sweep_ctrl_c_with_a_task_hung_exits_at_once_without_the_workers_tracebacks(tmp_path):
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    spec = tmp_path / "s.toml"
+    spec.write_text(f'task = "sweep_tasks:hangs"\n[grid]\na = [0, 1, 2]\npids = {str(pids)!r}\n')
+    child = _cli(
+        ["sweep", spec, "--out", tmp_path / "out", "--workers", "3", "--no-progress"],
+        start=subprocess.Popen,
+        start_new_session=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    workers = _worker_pids(pids, 3, child)  # a = 0 returned: its worker waits for more, a = 1 and 2 hang
+    try:
+        time.sleep(0.3)
+        os.killpg(child.pid, signal.SIGINT)  # Ctrl-C in a terminal: the sweep and its workers
+        _, err = child.communicate(timeout=10)
+        assert child.returncode == 130, err
+        assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+        assert "sweep interrupted with 2 of 3 tasks unfinished" in err
+        deadline = time.monotonic() + 5.0
+        while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(_alive(p) for p in workers), "the pool's workers outlived the sweep"
+    finally:
+        child.kill()
+        _stop(workers)
+
+
+@pytest.mark.slow
+def test_cli_sweep_killed_with_sigkill_leaves_no_worker_behind(tmp_path):
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    spec = tmp_path / "s.toml"  # a = 0 returns (its worker then waits for more), a = 1 hangs
+    spec.write_text(f'task = "sweep_tasks:hangs"\n[grid]\na = [0, 1]\npids = {str(pids)!r}\n')
+    child = _cli(
+        ["sweep", spec, "--out", tmp_path / "out", "--workers", "2", "--no-progress"],
+        start=subprocess.Popen,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    workers = _worker_pids(pids, 2, child)
+    try:
+        time.sleep(0.3)
+        os.kill(child.pid, signal.SIGKILL)  # the sweep alone: its workers are orphaned
+        child.wait()
+        deadline = time.monotonic() + 5.0
+        while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not [p for p in workers if _alive(p)], "workers outlived their killed sweep by 5 s"
+    finally:
+        _stop(workers)
 
 
 @pytest.mark.slow

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 __all__ = [
     "BoxTooSmallError",
+    "CacheWarning",
     "CheckpointError",
     "DiscsimError",
     "Interrupted",

@@ -114,11 +114,19 @@ class SweepCache:
             raise InvalidArgumentError(msg)
 
     def open(self) -> None:
-        """Create the folder and its manifest (when a sweep is about to run)."""
-        self.folder.mkdir(parents=True, exist_ok=True)
+        """Create the folder and its manifest (when a sweep is about to run).
+
+        Raises:
+            InvalidArgumentError: naming the folder, if it cannot be created or written.
+        """
         manifest = self.folder / MANIFEST
-        if not manifest.is_file():
-            self._write(manifest, {"format": "discsim sweep cache", "layout": LAYOUT, "task": self.task})
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            if not manifest.is_file():
+                self._write(manifest, {"format": "discsim sweep cache", "layout": LAYOUT, "task": self.task})
+        except OSError as exc:
+            msg = f"cache={str(self.folder)!r} cannot be created or written: {exc}"
+            raise InvalidArgumentError(msg) from exc
 
     def _path(self, key: str) -> Path:
         return self.folder / key[:2] / f"{key}.json"
@@ -178,7 +186,9 @@ class SweepCache:
 
     def __len__(self) -> int:
         """Entries stored (finished tasks of any grid, this task and version or older)."""
-        return sum(1 for _ in self.folder.glob("??/*.json")) if self.folder.is_dir() else 0
+        if not self.folder.is_dir():
+            return 0
+        return sum(1 for entry in self.folder.glob("??/*.json") if not entry.name.startswith("."))  # not a .tmp-
 
     @staticmethod
     def _write(path: Path, content: dict) -> None:

@@ -17,7 +17,7 @@ import sweep_tasks
 from paths import ROOT
 
 import discsim as ds
-from discsim.run.cache import MANIFEST
+from discsim.run.cache import MANIFEST, SweepCache
 from discsim.run.sweep import grid_points, seed_streams
 
 pd = pytest.importorskip("pandas")
@@ -145,6 +145,19 @@ def test_a_cache_entry_with_another_tasks_identity_or_no_checksum_is_not_served(
     assert again.twice.tolist() == [2, 6] and again.attrs["sweep"]["ran"] == 2
     messages = " ".join(str(w.message) for w in caught)
     assert one.name in messages and three.name in messages
+
+
+def _entries(cache: Path) -> list[Path]:
+    """The cache's entries (not the temporary file of one being written when the sweep was killed)."""
+    return [e for e in cache.glob("??/*.json") if not e.name.startswith(".")]
+
+
+def test_the_cache_counts_entries_not_the_temporary_file_a_kill_left(tmp_path):
+    cache = tmp_path / "c"
+    ds.sweep(sweep_tasks.draw, {"a": [1.0, 2.0]}, workers=0, cache=cache)
+    entry = sorted(cache.glob("??/*.json"))[0]
+    (entry.parent / ".tmp-k1ll3d.json").write_text('{"key": "half')  # killed between writing and os.replace
+    assert len(SweepCache(cache, "sweep_tasks:draw", ds.__version__)) == 2
 
 
 def test_version_is_part_of_the_key(tmp_path, monkeypatch):
@@ -307,6 +320,7 @@ def _bad_cases(tmp_path):
     foreign = tmp_path / "foreign"
     foreign.mkdir()
     (foreign / "notes.txt").write_text("mine")
+    (tmp_path / "a_file").write_text("mine")
     task = sweep_tasks.logged
     return [
         ((task, {}), {}, "the grid is empty"),
@@ -326,6 +340,7 @@ def _bad_cases(tmp_path):
         ((task, {"a": [1], "log": log}), {"client": object()}, "client must be a dask.distributed.Client"),
         ((task, {"a": [1], "log": log}), {"cache": other}, "another sweep's task, 'sweep_tasks:draw'"),
         ((task, {"a": [1], "log": log}), {"cache": foreign}, "holds files but is not a sweep cache"),
+        ((task, {"a": [1], "log": log}), {"cache": tmp_path / "a_file" / "c"}, "cannot be created or written"),
         ((lambda a, seed: {"a": a}, {"a": [1]}), {"workers": 1}, "cannot be sent to worker processes"),
         ((lambda a, seed: {"a": a}, {"a": [1]}), {"workers": 0, "cache": tmp_path / "l"}, "stable name"),
         ((42, {"a": [1]}), {}, "task must be a function"),
@@ -426,11 +441,11 @@ def test_cli_sweep_killed_half_way_resumes_running_only_the_missing_tasks(tmp_pa
         stderr=subprocess.DEVNULL,
     )
     deadline = time.monotonic() + 120.0
-    while len(list(cache.glob("??/*.json"))) < 3 and time.monotonic() < deadline and child.poll() is None:
+    while len(_entries(cache)) < 3 and time.monotonic() < deadline and child.poll() is None:
         time.sleep(0.05)
     os.killpg(child.pid, signal.SIGKILL)  # the sweep and its pool's worker
     child.wait()
-    kept = len(list(cache.glob("??/*.json")))
+    kept = len(_entries(cache))
     assert 3 <= kept < 8, "the kill did not land half-way"
     assert not (out / "sweep.csv").exists()
     done = _cli(["sweep", spec, "--out", out, "--workers", "2", "--no-progress"], capture_output=True, text=True)
@@ -439,6 +454,46 @@ def test_cli_sweep_killed_half_way_resumes_running_only_the_missing_tasks(tmp_pa
     whole = _cli(["sweep", spec, "--out", tmp_path / "whole", "--workers", "2", "--no-progress"], capture_output=True)
     assert whole.returncode == 0
     assert (out / "sweep.csv").read_text() == (tmp_path / "whole" / "sweep.csv").read_text()
+
+
+def test_cli_sweep_with_an_output_folder_it_cannot_write_says_so_without_a_traceback(tmp_path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(pause=0.0))
+    a_file = tmp_path / "a_file"
+    a_file.write_text("mine")
+    for out in [a_file, a_file / "below"]:
+        done = _cli(["sweep", spec, "--out", out, "--workers", "0"], capture_output=True, text=True)
+        assert done.returncode == 1, done.stderr
+        assert "Traceback" not in done.stderr and f"cannot create the output folder {str(out)!r}" in done.stderr
+    assert a_file.read_text() == "mine"
+    if os.name == "posix" and os.geteuid() != 0:  # root writes anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        done = _cli(["sweep", spec, "--out", locked, "--workers", "0"], capture_output=True, text=True)
+        assert done.returncode == 1 and "Traceback" not in done.stderr and str(locked) in done.stderr
+
+
+def test_cli_sweep_that_cannot_write_its_table_says_so_without_a_traceback(tmp_path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(pause=0.0))
+    out = tmp_path / "out"
+    (out / "sweep.csv").mkdir(parents=True)  # a folder where the table goes
+    done = _cli(["sweep", spec, "--out", out, "--workers", "0"], capture_output=True, text=True)
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert f"cannot write {str(out / 'sweep.csv')!r}" in done.stderr
+
+
+def test_cli_sweep_reports_a_damaged_cache_entry_on_a_line_of_its_own_and_runs_its_task_again(tmp_path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(pause=0.0))
+    args = ["sweep", spec, "--out", tmp_path / "out", "--workers", "0", "--no-progress"]
+    assert _cli(args, capture_output=True).returncode == 0
+    entry = _entries(tmp_path / "out" / "cache")[0]
+    entry.write_text(entry.read_text().replace('"first":0.', '"first":1.'))
+    done = _cli(args, capture_output=True, text=True)
+    assert done.returncode == 0 and "8 tasks (1 ran, 7 from the cache" in done.stdout, done.stderr
+    assert done.stderr.startswith(f"discsim sweep: warning: sweep cache: the entry {str(entry)!r} does not match")
+    assert len(done.stderr.splitlines()) == 1
 
 
 @pytest.mark.slow
@@ -495,6 +550,36 @@ def test_cli_sweep_killed_with_sigkill_leaves_no_worker_behind(tmp_path):
         assert not [p for p in workers if _alive(p)], "workers outlived their killed sweep by 5 s"
     finally:
         _stop(workers)
+
+
+@pytest.mark.parametrize(
+    "where",
+    [
+        ["--workers", "0"],
+        ["--workers", "2"],
+        pytest.param(["--scheduler", "local", "--workers", "2"], marks=pytest.mark.slow),
+    ],
+    ids=["in-process", "local-pool", "dask-local-cluster"],
+)
+def test_cli_sweep_imports_the_task_from_the_current_folder_in_the_workers_too(tmp_path, where):
+    if "--scheduler" in where:
+        pytest.importorskip("distributed")
+    (tmp_path / "mytask.py").write_text("def free_path(a, *, seed):\n    return {'a2': a * a}\n")
+    (tmp_path / "s.toml").write_text('task = "mytask:free_path"\n[grid]\na = [1, 2, 3]\n')
+    bin_folder = tmp_path / "bin"  # as the installed `discsim` script: its own folder is sys.path[0], not "."
+    bin_folder.mkdir()
+    (bin_folder / "discsim").write_text(
+        "import sys\nfrom discsim.cli import main\nif __name__ == '__main__':\n    sys.exit(main())\n"
+    )
+    done = subprocess.run(
+        [sys.executable, bin_folder / "discsim", "sweep", "s.toml", "--out", "out", "--no-progress", *where],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    assert pd.read_csv(tmp_path / "out" / "sweep.csv").a2.tolist() == [1, 4, 9]
 
 
 @pytest.mark.slow

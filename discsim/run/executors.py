@@ -139,13 +139,18 @@ PARENT_CHECK_SECONDS = 0.5
 UNATTRIBUTED_DEATHS = 3
 
 
-def _worker_start(parent: int) -> None:
+def _worker_start(sweep: int) -> None:
     """Set up a worker of the local pool (its initializer): it ignores Ctrl-C and dies with its sweep.
 
     Ctrl-C in a terminal reaches every process of the group: the sweep stops its workers itself, so that
     they print no traceback. A worker whose sweep died (kill -9) would wait for tasks forever: on Linux the
-    kernel kills it (``PR_SET_PDEATHSIG``), elsewhere a thread of its own sees its parent change and exits.
+    kernel kills it (``PR_SET_PDEATHSIG``); on every system a thread of its own exits when its parent goes
+    (on POSIX its parent pid changes; on Windows the parent's process handle is signalled).
+
+    Args:
+        sweep: the pid of the sweep's process (the parent, under ``fork`` and ``spawn``).
     """
+    import multiprocessing
     import signal
     import threading
 
@@ -158,14 +163,26 @@ def _worker_start(parent: int) -> None:
             libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG = 1
         except (OSError, AttributeError):
             pass  # the thread below does it
-    if os.getppid() != parent:  # the sweep died while this worker started
-        os._exit(1)
+    parent = os.getppid()
+    parent_process = multiprocessing.parent_process()
+
+    def orphaned() -> bool:
+        if os.name == "nt":  # no reparenting there (and os.kill(pid, 0) would end the process)
+            return parent_process is not None and not parent_process.is_alive()
+        return os.getppid() != parent
+
+    if os.name != "nt" and parent != sweep:  # the sweep died while this worker started (or a forkserver forked it)
+        try:
+            os.kill(sweep, 0)
+        except ProcessLookupError:
+            os._exit(1)
+        except OSError:
+            pass
 
     def watch() -> None:
-        while True:
+        while not orphaned():
             time.sleep(PARENT_CHECK_SECONDS)
-            if os.getppid() != parent:
-                os._exit(1)
+        os._exit(1)
 
     threading.Thread(target=watch, name="discsim-sweep-parent-watch", daemon=True).start()
 

@@ -187,21 +187,42 @@ def _worker_start(sweep: int) -> None:
     threading.Thread(target=watch, name="discsim-sweep-parent-watch", daemon=True).start()
 
 
-def _attempt_marked(marks: str, token: int, task, params: dict, seed: int):
-    """:func:`attempt` in a worker of the local pool, with a file in ``marks`` while the task runs.
+#: A worker's mark: the token of the task it runs, or blanks between tasks (fixed width, rewritten in place).
+MARK_WIDTH = 20
+_mark: list = [None, -1]  # in a worker: the marks folder its file is in, and the file's descriptor
 
-    A worker that dies leaves its task's mark behind: that tells the sweep which task was running.
+
+def _attempt_marked(marks: str, token: int, task, params: dict, seed: int):
+    """:func:`attempt` in a worker of the local pool, marked: while the task runs, the worker's file in
+    ``marks`` (named by its pid) holds the task's token.
+
+    A worker that dies leaves its task's token there: that tells the sweep which task was running. (One
+    file per worker, rewritten in place: two small writes per task, no file created or removed.)
     """
-    mark = os.path.join(marks, str(token))
-    with open(mark, "w"):
-        pass
+    if _mark[0] != marks:
+        _mark[:] = [marks, os.open(os.path.join(marks, str(os.getpid())), os.O_WRONLY | os.O_CREAT, 0o600)]
+    fd = _mark[1]
+    os.lseek(fd, 0, os.SEEK_SET)
+    os.write(fd, str(token).rjust(MARK_WIDTH).encode())
     try:
         return attempt(task, params, seed)
     finally:
+        os.lseek(fd, 0, os.SEEK_SET)
+        os.write(fd, b" " * MARK_WIDTH)
+
+
+def _marked_tokens(marks: str) -> set[int]:
+    """The tokens the workers' files in ``marks`` hold: the tasks that were running when they stopped."""
+    tokens = set()
+    for name in os.listdir(marks):
         try:
-            os.unlink(mark)
+            with open(os.path.join(marks, name), "rb") as f:
+                text = f.read(MARK_WIDTH).strip()
         except OSError:
-            pass
+            continue
+        if text.isdigit():
+            tokens.add(int(text))
+    return tokens
 
 
 class _Attempt:
@@ -210,8 +231,8 @@ class _Attempt:
     future: Future  # set when it is sent to a pool, as is:
     pool: ProcessPoolExecutor
 
-    def __init__(self, token: int, args: tuple):
-        self.token = token
+    def __init__(self, args: tuple):
+        self.token = -1  # set, afresh, each time it is sent to a pool
         self.args = args
         self.outcome: tuple | None = None
 
@@ -225,10 +246,10 @@ class LocalPool(_Finished):
     A worker that dies (``os._exit``, a crash, the kernel's OOM killer) breaks a
     ``ProcessPoolExecutor``: every task it holds fails with ``BrokenProcessPool``. Here only the task that
     was running in the dead worker counts a failed attempt; the others are sent again to a new pool, as if
-    nothing happened. Each worker marks (a file in a temporary folder) the task it runs, so after a break
-    the tasks that were running are known: when only one was, it is the one. When several were (one per
-    busy worker), the dead one is not known: those tasks run again one at a time on a pool of one worker,
-    where a death can only be the running task's.
+    nothing happened. Each worker writes the task it runs into a file of its own (in a temporary folder),
+    so after a break the tasks that were running are known: when only one was, it is the one. When several
+    were (one per busy worker), the dead one is not known: those tasks run again one at a time on a pool of
+    one worker, where a death can only be the running task's.
     """
 
     def __init__(self, workers: int):
@@ -266,7 +287,7 @@ class LocalPool(_Finished):
         return self._marks
 
     def submit(self, *args):
-        job = _Attempt(next(self._tokens), args)
+        job = _Attempt(args)
         self._send(job, solo=False)
         return job
 
@@ -276,6 +297,7 @@ class LocalPool(_Finished):
         for _ in range(2):
             pool = self._executor(solo)
             try:
+                job.token = next(self._tokens)
                 future = pool.submit(_attempt_marked, self._marks_folder(), job.token, *job.args)
             except BrokenProcessPool:  # it broke since: its tasks come back through next_done; a new pool here
                 self._pools.pop(solo, None)
@@ -318,9 +340,8 @@ class LocalPool(_Finished):
                 del self._pools[solo]
         pool.shutdown(wait=False, cancel_futures=True)
         marks = self._marks_folder()
-        started = [job for job in held if os.path.exists(os.path.join(marks, str(job.token)))]
-        for job in started:
-            os.unlink(os.path.join(marks, str(job.token)))
+        running = _marked_tokens(marks)  # each send has a token of its own: a dead pool's marks never match again
+        started = [job for job in held if job.token in running]
         if len(started) == 1:
             (dead,) = started
             params, seed = dead.args[1], dead.args[2]

@@ -86,6 +86,7 @@ class SweepCache:
         self.folder = Path(folder)
         self.task = task
         self.version = version
+        self._unchecked = False  # the folder is of layout 1 (entries without checksums)
         self._check_folder()
 
     def _check_folder(self) -> None:
@@ -122,11 +123,19 @@ class SweepCache:
         manifest = self.folder / MANIFEST
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
-            if not manifest.is_file():
+            layout = json.loads(manifest.read_text()).get("layout") if manifest.is_file() else None
+            if layout != LAYOUT:
                 self._write(manifest, {"format": "discsim sweep cache", "layout": LAYOUT, "task": self.task})
-        except OSError as exc:
+        except (OSError, ValueError, AttributeError) as exc:
             msg = f"cache={str(self.folder)!r} cannot be created or written: {exc}"
             raise InvalidArgumentError(msg) from exc
+        if layout is not None and layout != LAYOUT:  # entries of layout 1 have no checksum: not served
+            self._unchecked = True
+            msg = (
+                f"sweep cache: {str(self.folder)!r} was written by an older discsim, without checksums: its "
+                f"entries are not used, their tasks run again and are stored with checksums"
+            )
+            warnings.warn(msg, CacheWarning, stacklevel=4)  # open <- _run <- sweep <- the caller
 
     def _path(self, key: str) -> Path:
         return self.folder / key[:2] / f"{key}.json"
@@ -149,6 +158,8 @@ class SweepCache:
             entry = json.loads(text)
         except ValueError as exc:
             return self._refuse(path, f"cannot be read: it is not whole JSON ({exc})")
+        if isinstance(entry, dict) and CHECKSUM not in entry and self._unchecked:
+            return None  # an entry of layout 1, which open() reported for the whole folder
         if not isinstance(entry, dict) or not isinstance(entry.get(CHECKSUM), str):
             return self._refuse(path, "has no checksum (damaged, or written by an older discsim)")
         if entry[CHECKSUM] != checksum(entry):

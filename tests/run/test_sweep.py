@@ -160,6 +160,25 @@ def test_the_cache_counts_entries_not_the_temporary_file_a_kill_left(tmp_path):
     assert len(SweepCache(cache, "sweep_tasks:draw", ds.__version__)) == 2
 
 
+def test_a_cache_of_the_layout_without_checksums_is_reported_once_and_computed_again(tmp_path):
+    cache = tmp_path / "c"
+    first = ds.sweep(sweep_tasks.fails_at, {"a": [1, 3, 4]}, workers=0, cache=cache)
+    manifest = json.loads((cache / MANIFEST).read_text())
+    (cache / MANIFEST).write_text(json.dumps({**manifest, "layout": 1}))  # as discsim 0.1.0 wrote it
+    for entry in _entries(cache):
+        old = json.loads(entry.read_text())
+        del old["checksum"]
+        entry.write_text(json.dumps(old))
+    with pytest.warns(ds.CacheWarning) as caught:
+        again = ds.sweep(sweep_tasks.fails_at, {"a": [1, 3, 4]}, workers=0, cache=cache)
+    assert len(caught) == 1 and "written by an older discsim, without checksums" in str(caught[0].message)
+    pd.testing.assert_frame_equal(again, first)
+    assert again.attrs["sweep"]["ran"] == 3 and json.loads((cache / MANIFEST).read_text())["layout"] == 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert ds.sweep(sweep_tasks.fails_at, {"a": [1, 3, 4]}, workers=0, cache=cache).attrs["sweep"]["cached"] == 3
+
+
 def test_version_is_part_of_the_key(tmp_path, monkeypatch):
     cache = tmp_path / "c"
     ds.sweep(sweep_tasks.draw, {"a": [1.0]}, workers=0, cache=cache)

@@ -34,6 +34,7 @@ from discsim.engines.event_driven import EventDriven, EventDrivenState
 from discsim.engines.fixed_step import POLICIES, FixedStep, FixedStepState
 from discsim.errors import (
     BoxTooSmallError,
+    CacheWarning,
     CheckpointError,
     DiscsimError,
     Interrupted,
@@ -80,6 +81,7 @@ __all__ = [
     "POLICIES",
     "Box",
     "BoxTooSmallError",
+    "CacheWarning",
     "Callback",
     "CheckpointError",
     "Checkpointer",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 __all__ = [
     "BoxTooSmallError",
+    "CacheWarning",
     "CheckpointError",
     "DiscsimError",
     "Interrupted",
@@ -75,6 +76,10 @@ class UnitsError(DiscsimError, ValueError):
 
 class CheckpointError(DiscsimError, ValueError):
     """A checkpoint or event-log file that is damaged, foreign or incompatible."""
+
+
+class CacheWarning(UserWarning):
+    """A sweep's cache entry that was damaged or changed: reported, not served, and computed again."""
 
 
 class Interrupted(KeyboardInterrupt):

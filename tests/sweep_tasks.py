@@ -58,3 +58,19 @@ def dies(a, *, seed):
 
 def not_a_dict(a, *, seed):
     return [a]
+
+
+def dies_beside_others(a, *, seed, pause=0.3):
+    """Kills its own worker at a == 1, after ``pause`` seconds (while the other workers run tasks of their own)."""
+    time.sleep(pause)
+    if a == 1:
+        os._exit(3)
+    return {"a2": a * a}
+
+
+def hangs(a, *, seed, pids: str, hang=60.0):
+    """Writes its worker's pid into the folder ``pids`` (file ``a``), then hangs ``hang`` seconds at ``a >= 1``."""
+    (Path(pids) / f"{a}").write_text(str(os.getpid()))
+    if a >= 1:
+        time.sleep(hang)
+    return {"a2": a * a}

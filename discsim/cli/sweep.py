@@ -10,6 +10,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from discsim.cli._common import make_output_folder
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -60,10 +62,13 @@ def handle(args: argparse.Namespace) -> int:
     from discsim.run.spec import read_spec
 
     out = Path(args.out)
+    _import_from_current_folder()
     try:
         spec = read_spec(args.spec)
     except ds.DiscsimError as exc:
         print(f"discsim sweep: {exc}", file=sys.stderr)
+        return 1
+    if not make_output_folder("sweep", out):
         return 1
     with ExitStack() as stack:
         client = None
@@ -92,6 +97,7 @@ def handle(args: argparse.Namespace) -> int:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # failures are reported below
+                warnings.showwarning = _show_warning  # a line of its own, not a source line
                 table = ds.sweep(
                     spec.task,
                     spec.grid,
@@ -112,6 +118,23 @@ def handle(args: argparse.Namespace) -> int:
     return write_sweep(table, out)
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print a warning of the sweep (a damaged cache entry) as ``discsim sweep: warning: ...``."""
+    print(f"discsim sweep: warning: {message}", file=sys.stderr)
+
+
+def _import_from_current_folder() -> None:
+    """Put the current folder first on ``sys.path``, as ``python -m`` does, so that the spec's
+    ``task = "mytask:function"`` finds ``./mytask.py`` (the installed ``discsim`` script puts its own folder
+    there instead). The local pool's workers inherit the path (fork) or are given it (spawn, dask's
+    LocalCluster)."""
+    import os
+
+    here = os.getcwd()
+    if not any(os.path.abspath(entry or os.curdir) == here for entry in sys.path):
+        sys.path.insert(0, here)
+
+
 def write_sweep(table: pd.DataFrame, out: Path) -> int:
     """Write the sweep's table (CSV, and Parquet when pyarrow is installed) and its failures into ``out``, print
     what ran; return the exit code (1 when a task failed every attempt)."""
@@ -119,27 +142,42 @@ def write_sweep(table: pd.DataFrame, out: Path) -> int:
 
     info, failures = table.attrs["sweep"], table.attrs["failures"]
     csv = out / SWEEP_FILES["csv"]
-    tmp = csv.with_name(f".{csv.name}.tmp")
-    table.to_csv(tmp, index=False)
-    os.replace(tmp, csv)
-    written = [str(csv)]
+    written = []
+    target = csv
     try:
-        import pyarrow  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        parquet = out / SWEEP_FILES["parquet"]
-        table.to_parquet(parquet, index=False)
-        written.append(str(parquet))
-    report = out / SWEEP_FILES["failures"]
-    if failures:
-        lines = []
-        for f in failures:
-            lines += [f"{f['params']} seed={f['seed']} ({f['attempts']} attempts): {f['error']}", f["traceback"], ""]
-        report.write_text("\n".join(lines))
-        written.append(str(report))
-    else:
-        report.unlink(missing_ok=True)
+        tmp = csv.with_name(f".{csv.name}.tmp")
+        table.to_csv(tmp, index=False)
+        os.replace(tmp, csv)
+        written.append(str(csv))
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            pass
+        else:
+            target = out / SWEEP_FILES["parquet"]
+            table.to_parquet(target, index=False)
+            written.append(str(target))
+        target = out / SWEEP_FILES["failures"]
+        if failures:
+            lines = []
+            for f in failures:
+                lines += [
+                    f"{f['params']} seed={f['seed']} ({f['attempts']} attempts): {f['error']}",
+                    f["traceback"],
+                    "",
+                ]
+            target.write_text("\n".join(lines))
+            written.append(str(target))
+        else:
+            target.unlink(missing_ok=True)
+    except OSError as exc:
+        Path(csv.with_name(f".{csv.name}.tmp")).unlink(missing_ok=True)
+        print(
+            f"discsim sweep: cannot write {str(target)!r}: {exc}; every finished task is in the cache "
+            f"{str(out / SWEEP_FILES['cache'])!r}, so the same command writes the table without running them again",
+            file=sys.stderr,
+        )
+        return 1
     print(
         f"discsim sweep: {info['tasks']} tasks ({info['ran']} ran, {info['cached']} from the cache, "
         f"{info['failed']} failed, {info['retries']} retries) in {info['seconds']:.1f} s on {info['where']}"

@@ -2,9 +2,14 @@
 
 A task's *key* is the SHA-256 of its identity: the task's name, its parameters, its seed and discsim's
 version (canonical JSON, sorted keys). Its entry, ``<folder>/<key[:2]>/<key>.json``, holds the identity
-beside the result, and is written atomically (a temporary file in the same folder, then ``os.replace``),
-so a sweep killed at any moment leaves only whole entries; one that cannot be read is taken as missing
-and computed again. The folder's manifest, ``discsim-sweep.json``, names the task whose results it holds:
+beside the result and a ``checksum`` (the SHA-256 of the rest of the entry as canonical JSON), and is
+written atomically (a temporary file in the same folder, then ``os.replace``), so a sweep killed at any
+moment leaves only whole entries. An entry is served only when it reads back whole and unchanged: one that
+cannot be read, whose checksum does not match (a bit flipped on disk, a number changed by hand), that has
+no checksum, or that holds another task's identity, is reported (a :class:`~discsim.errors.CacheWarning`
+naming the file), never served, and computed again (and overwritten). The checksum finds damage and edits,
+not forgery: whoever can write the folder can also write a matching checksum.
+The folder's manifest, ``discsim-sweep.json``, names the task whose results it holds:
 a folder of another task's results, or one holding files that are no sweep's, is refused before anything
 runs, so two studies never mix their numbers.
 
@@ -18,20 +23,37 @@ import json
 import math
 import os
 import tempfile
+import warnings
 from pathlib import Path
 
-from discsim.errors import InvalidArgumentError
+from discsim.errors import CacheWarning, InvalidArgumentError
 
-__all__ = ["MANIFEST", "SweepCache", "task_key"]
+__all__ = ["MANIFEST", "SweepCache", "checksum", "task_key"]
 
 #: The manifest naming the task a cache folder belongs to.
 MANIFEST = "discsim-sweep.json"
-#: The layout of the folder; a later layout would refuse (or convert) an older one.
-LAYOUT = 1
+#: The layout of the folder; a later layout would refuse (or convert) an older one. (Entries of layout 1
+#: had no checksum: they are reported and computed again.)
+LAYOUT = 2
+#: The field of an entry that holds the SHA-256 of the rest of it.
+CHECKSUM = "checksum"
 
 
 def _canonical(identity: dict) -> str:
     return json.dumps(identity, sort_keys=True, separators=(",", ":"), allow_nan=True)
+
+
+def checksum(entry: dict) -> str:
+    """The hex SHA-256 of an entry without its ``checksum`` field (canonical JSON): what the field must hold.
+
+    Example:
+        >>> checksum({"result": {"y": 1.0}}) == checksum({"result": {"y": 1.0}, "checksum": "anything"})
+        True
+        >>> checksum({"result": {"y": 1.0}}) == checksum({"result": {"y": 2.0}})
+        False
+    """
+    content = {name: value for name, value in entry.items() if name != CHECKSUM}
+    return hashlib.sha256(_canonical(content).encode()).hexdigest()
 
 
 def task_key(task: str, params: dict, seed: int, version: str) -> str:
@@ -64,6 +86,7 @@ class SweepCache:
         self.folder = Path(folder)
         self.task = task
         self.version = version
+        self._unchecked = False  # the folder is of layout 1 (entries without checksums)
         self._check_folder()
 
     def _check_folder(self) -> None:
@@ -92,25 +115,67 @@ class SweepCache:
             raise InvalidArgumentError(msg)
 
     def open(self) -> None:
-        """Create the folder and its manifest (when a sweep is about to run)."""
-        self.folder.mkdir(parents=True, exist_ok=True)
+        """Create the folder and its manifest (when a sweep is about to run).
+
+        Raises:
+            InvalidArgumentError: naming the folder, if it cannot be created or written.
+        """
         manifest = self.folder / MANIFEST
-        if not manifest.is_file():
-            self._write(manifest, {"format": "discsim sweep cache", "layout": LAYOUT, "task": self.task})
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            layout = json.loads(manifest.read_text()).get("layout") if manifest.is_file() else None
+            if layout != LAYOUT:
+                self._write(manifest, {"format": "discsim sweep cache", "layout": LAYOUT, "task": self.task})
+        except (OSError, ValueError, AttributeError) as exc:
+            msg = f"cache={str(self.folder)!r} cannot be created or written: {exc}"
+            raise InvalidArgumentError(msg) from exc
+        if layout is not None and layout != LAYOUT:  # entries of layout 1 have no checksum: not served
+            self._unchecked = True
+            msg = (
+                f"sweep cache: {str(self.folder)!r} was written by an older discsim, without checksums: its "
+                f"entries are not used, their tasks run again and are stored with checksums"
+            )
+            warnings.warn(msg, CacheWarning, stacklevel=4)  # open <- _run <- sweep <- the caller
 
     def _path(self, key: str) -> Path:
         return self.folder / key[:2] / f"{key}.json"
 
     def get(self, params: dict, seed: int) -> dict | None:
-        """The stored entry of a finished task (``result``, ``seconds``, ``attempts``), or None."""
+        """The stored entry of a finished task (``result``, ``seconds``, ``attempts``), or None.
+
+        None when the task has no entry, and also, with a :class:`~discsim.errors.CacheWarning` naming the
+        file, when its entry is damaged or changed (see the module docstring): the task is then run again.
+        """
         key = task_key(self.task, params, seed, self.version)
+        path = self._path(key)
         try:
-            entry = json.loads(self._path(key).read_text())
-        except (OSError, ValueError):
-            return None  # missing, or unreadable: computed again and overwritten
-        if not isinstance(entry, dict) or entry.get("key") != key or not isinstance(entry.get("result"), dict):
+            text = path.read_bytes().decode()
+        except FileNotFoundError:
             return None
+        except (OSError, UnicodeDecodeError) as exc:
+            return self._refuse(path, f"cannot be read ({exc})")
+        try:
+            entry = json.loads(text)
+        except ValueError as exc:
+            return self._refuse(path, f"cannot be read: it is not whole JSON ({exc})")
+        if isinstance(entry, dict) and CHECKSUM not in entry and self._unchecked:
+            return None  # an entry of layout 1, which open() reported for the whole folder
+        if not isinstance(entry, dict) or not isinstance(entry.get(CHECKSUM), str):
+            return self._refuse(path, "has no checksum (damaged, or written by an older discsim)")
+        if entry[CHECKSUM] != checksum(entry):
+            return self._refuse(path, "does not match its checksum: it was damaged or changed after it was written")
+        identity = {"key": key, "task": self.task, "params": params, "seed": int(seed), "version": self.version}
+        wrong = [name for name, value in identity.items() if entry.get(name) != value]
+        if wrong or not isinstance(entry.get("result"), dict):
+            what = f"its {wrong[0]} is {entry.get(wrong[0])!r}, not {identity[wrong[0]]!r}" if wrong else "no result"
+            return self._refuse(path, f"holds another task's entry ({what})")
         return entry
+
+    @staticmethod
+    def _refuse(path: Path, why: str) -> None:
+        msg = f"sweep cache: the entry {str(path)!r} {why}; it is not used, and the task runs again"
+        warnings.warn(msg, CacheWarning, stacklevel=5)  # _refuse <- get <- _run <- sweep <- the caller
+        return None
 
     def put(self, params: dict, seed: int, result: dict, seconds: float, attempts: int) -> None:
         """Store a finished task's result (atomically)."""
@@ -125,13 +190,16 @@ class SweepCache:
             "seconds": float(seconds) if math.isfinite(seconds) else None,
             "attempts": int(attempts),
         }
+        entry[CHECKSUM] = checksum(entry)
         path = self._path(key)
         path.parent.mkdir(parents=True, exist_ok=True)
         self._write(path, entry)
 
     def __len__(self) -> int:
         """Entries stored (finished tasks of any grid, this task and version or older)."""
-        return sum(1 for _ in self.folder.glob("??/*.json")) if self.folder.is_dir() else 0
+        if not self.folder.is_dir():
+            return 0
+        return sum(1 for entry in self.folder.glob("??/*.json") if not entry.name.startswith("."))  # not a .tmp-
 
     @staticmethod
     def _write(path: Path, content: dict) -> None:

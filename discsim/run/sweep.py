@@ -14,8 +14,13 @@ results in a tidy table (a pandas DataFrame). It brings no scheduler of its own:
   missing.
 - **Failures.** A task that raises is run again, up to ``retries`` more times; if it still fails, the sweep
   finishes the others, and the table keeps its row with the error (``error`` column) while
-  ``table.attrs["failures"]`` holds its parameters, seed, error, traceback and attempts. A worker that dies
-  (or a cluster that loses it) counts as a failed attempt of the tasks it held.
+  ``table.attrs["failures"]`` holds its parameters, seed, error, traceback and attempts. A local worker
+  that dies (``os._exit``, a crash, a kill) counts a failed attempt (``WorkerDied``, naming the parameters)
+  of the task it was running, and of no other: the pool is started again and the other tasks it held are
+  sent again. On dask, the cluster decides (it retries tasks whose worker it lost, then reports them).
+- **Stopping.** Ctrl-C stops the local pool's workers (a hung task included) and raises
+  :class:`~discsim.errors.Interrupted` at once; the workers ignore Ctrl-C themselves (no tracebacks of
+  theirs). A worker whose sweep is killed (kill -9) exits too, instead of waiting for tasks forever.
 - **Determinism.** The table does not depend on where, in which order or how many at a time the tasks ran:
   rows are in grid order (the last parameter varying fastest), then seed order, and wall-clock figures are
   kept out of it (they are in ``table.attrs["sweep"]``).
@@ -29,9 +34,7 @@ import itertools
 import json
 import os
 import pickle
-import sys
 import time
-import traceback
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -41,21 +44,17 @@ import numpy as np
 
 from discsim._validate import is_count
 from discsim.errors import InvalidArgumentError, WrongTypeError
+from discsim.run.executors import ERROR_COLUMN, SEED_COLUMN, LocalPool, json_scalar, make_executor, outcome_of
 
 if TYPE_CHECKING:
-    from concurrent.futures import Future, ProcessPoolExecutor
     from types import ModuleType
 
     from pandas import DataFrame
 
     from discsim.run.cache import SweepCache
+    from discsim.run.executors import Executor
 
 __all__ = ["ERROR_COLUMN", "SEED_COLUMN", "grid_points", "seed_streams", "sweep", "task_name"]
-
-#: The column of the seed each task was given, after the grid's parameters.
-SEED_COLUMN = "seed"
-#: The last column: None where the task finished, else its error (``"ValueError: ..."``).
-ERROR_COLUMN = "error"
 
 
 @dataclass
@@ -74,19 +73,6 @@ class _Job:
 
 
 # --- what the user gave ----------------------------------------------------------------------------------
-
-
-def _plain(value):
-    """A parameter or result value as a JSON scalar (bool, int, float, str or None), or raise TypeError."""
-    if value is None or isinstance(value, str):
-        return value
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value)
-    raise TypeError(type(value).__name__)
 
 
 def task_name(task) -> str:
@@ -179,7 +165,7 @@ def _check_name(name) -> None:
 
 def _check_value(name: str, value):
     try:
-        return _plain(value)
+        return json_scalar(value)
     except TypeError:
         msg = f"grid[{name!r}] holds {value!r}: parameter values must be numbers, strings, bools or None"
         raise InvalidArgumentError(msg) from None
@@ -252,182 +238,6 @@ def _check_task(task, names: list[str], name: str) -> None:
         raise InvalidArgumentError(msg)
 
 
-# --- where the tasks run ---------------------------------------------------------------------------------
-
-
-def attempt(task, params: dict, seed: int):
-    """Run one task once (in a worker): ``("ok", result, seconds)`` or ``("error", text, traceback, seconds)``.
-
-    The result must be a dict of scalars (numbers, strings, bools, None): the table's columns.
-    """
-    start = time.perf_counter()
-    try:
-        out = task(**params, seed=seed)
-        if not isinstance(out, Mapping):
-            msg = f"the task returned {type(out).__name__}, not a dict of results (the table's columns)"
-            raise TypeError(msg)
-        result = {}
-        for key, value in out.items():
-            if not isinstance(key, str) or key in params or key in (SEED_COLUMN, ERROR_COLUMN):
-                msg = f"the task returned the result {key!r}, which is no name or clashes with a parameter or column"
-                raise ValueError(msg)
-            try:
-                result[key] = _plain(value)
-            except TypeError:
-                msg = f"the task returned {key}={value!r}: results must be numbers, strings, bools or None"
-                raise TypeError(msg) from None
-    except Exception as exc:
-        return ("error", f"{type(exc).__name__}: {exc}", traceback.format_exc(), time.perf_counter() - start)
-    return ("ok", result, time.perf_counter() - start)
-
-
-class _Deferred:
-    """A task of ``workers=0``: it runs when the sweep waits for it."""
-
-    def __init__(self, args):
-        self.args = args
-        self.outcome = None
-
-    def result(self):
-        if self.outcome is None:
-            self.outcome = attempt(*self.args)
-        return self.outcome
-
-
-class _InProcess:
-    """``workers=0``: the tasks run here, one after another (for debugging: breakpoints work)."""
-
-    label = "this process"
-
-    def __init__(self):
-        self._pending = []
-
-    def submit(self, *args):
-        task = _Deferred(args)
-        self._pending.append(task)
-        return task
-
-    def next_done(self):
-        task = self._pending.pop(0)
-        task.result()
-        return task
-
-    def close(self, cancel: bool = False) -> None:
-        self._pending.clear()
-
-
-class _Finished:
-    """Futures as they finish, in O(1) each: every future puts itself in a queue when done.
-
-    (Waiting on all unfinished futures after each completion would cost O(tasks) each time.)
-    """
-
-    label: str  # where the tasks run, for the table's attrs (set by each subclass)
-
-    def __init__(self) -> None:
-        import queue
-
-        self._done: queue.SimpleQueue[Future] = queue.SimpleQueue()
-
-    def track(self, future):
-        future.add_done_callback(self._done.put)
-        return future
-
-    def next_done(self):
-        import queue
-
-        while True:  # a timeout, so that Ctrl-C is seen while waiting
-            try:
-                return self._done.get(timeout=0.2)
-            except queue.Empty:
-                continue
-
-
-class _LocalPool(_Finished):
-    """A process pool on this machine (``fork`` on Linux, so tasks defined in a notebook or script run)."""
-
-    def __init__(self, workers: int):
-        super().__init__()
-        self.workers = workers
-        self.label = f"{workers} local process{'es' if workers > 1 else ''}"
-        self._pool: ProcessPoolExecutor | None = None
-
-    def _executor(self) -> ProcessPoolExecutor:
-        if self._pool is None:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            context = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
-            self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=context)
-        return self._pool
-
-    def submit(self, *args):
-        from concurrent.futures.process import BrokenProcessPool
-
-        pool = self._executor()
-        try:
-            return self.track(pool.submit(attempt, *args))
-        except BrokenProcessPool:  # a worker died: a new pool for what is left
-            pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
-            return self.track(self._executor().submit(attempt, *args))
-
-    def close(self, cancel: bool = False) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=not cancel, cancel_futures=cancel)
-            self._pool = None
-
-
-class _Dask(_Finished):
-    """A ``dask.distributed.Client``: the tasks go to its cluster; nothing is started or closed here."""
-
-    def __init__(self, client):
-        super().__init__()
-        self.client = client
-        self._futures = []
-        workers = len(client.scheduler_info().get("workers", {}))
-        self.label = f"dask at {client.scheduler.address} ({workers} worker{'s' if workers != 1 else ''})"
-
-    def submit(self, *args):
-        future = self.client.submit(attempt, *args, pure=False)
-        self._futures.append(future)
-        return self.track(future)
-
-    def close(self, cancel: bool = False) -> None:
-        if cancel and self._futures:
-            self.client.cancel(self._futures)
-        self._futures.clear()
-
-
-def _executor(client, workers):
-    if client is not None:
-        if workers is not None:
-            msg = f"workers={workers!r} is for the local pool: a dask client brings its own workers"
-            raise InvalidArgumentError(msg)
-        if not (callable(getattr(client, "submit", None)) and hasattr(client, "status")):
-            msg = f"client must be a dask.distributed.Client (or None for a local pool), got {client!r}"
-            raise WrongTypeError(msg)
-        if str(getattr(client, "status", "")) in ("closed", "closing", "failed"):
-            msg = f"the dask client is {client.status}: connect a new one (dask.distributed.Client(...))"
-            raise InvalidArgumentError(msg)
-        return _Dask(client)
-    if workers is None:
-        workers = os.cpu_count() or 1
-    if not is_count(workers) or isinstance(workers, bool) or workers < 0:
-        msg = f"workers must be an integer >= 0 (0 runs the tasks in this process), got {workers!r}"
-        raise InvalidArgumentError(msg)
-    return _InProcess() if workers == 0 else _LocalPool(int(workers))
-
-
-def _outcome(future):
-    """What a finished future holds, with a lost worker or cluster as an error of the attempt."""
-    try:
-        return future.result()
-    except Exception as exc:  # the worker died, or the cluster lost the task (not the task's own error)
-        text = f"{type(exc).__name__}: the worker running the task was lost ({exc})"
-        return ("error", text, traceback.format_exc(), float("nan"))
-
-
 # --- the sweep -------------------------------------------------------------------------------------------
 
 
@@ -463,7 +273,8 @@ def sweep(
             run twice, and a killed sweep resumes where it stopped. None: no cache. The key holds the
             task's name and discsim's version, not their code: after changing the task (or discsim
             without a new version), give the sweep a new folder, or its old results are served.
-        retries: more attempts for a task that raised (or whose worker died) before it counts as failed.
+        retries: more attempts for a task that raised (or whose worker died while running it) before it
+            counts as failed.
         progress: show a bar over the tasks (tqdm when installed).
 
     Returns:
@@ -479,10 +290,12 @@ def sweep(
     Raises:
         InvalidArgumentError: before any task runs, for an empty grid, a parameter the task does not
             take (or one it needs that the grid lacks), bad seeds, retries or workers, a closed client,
-            or a cache folder that holds another task's results or files of its own.
+            a cache folder that holds another task's results or files of its own, or one that cannot be
+            created or written.
         WrongTypeError: if ``task`` is not callable, ``grid`` is neither a dict nor a list, or ``client``
             is not a dask client.
-        Interrupted: on Ctrl-C, after the pool is stopped; every finished result is in the cache.
+        Interrupted: on Ctrl-C, after the pool's workers are stopped (a hung task too); every finished
+            result is in the cache.
 
     Example:
         >>> import discsim as ds
@@ -501,8 +314,8 @@ def sweep(
     if not is_count(retries) or isinstance(retries, bool) or retries < 0:
         msg = f"retries must be an integer >= 0 (more attempts for a task that failed), got {retries!r}"
         raise InvalidArgumentError(msg)
-    executor = _executor(client, workers)
-    if isinstance(executor, _LocalPool):
+    executor = make_executor(client, workers)
+    if isinstance(executor, LocalPool):
         try:
             pickle.dumps(task)
         except Exception as exc:
@@ -563,7 +376,7 @@ def _run(pd, task, name, jobs, executor, store, retries, progress):
         while inflight:
             future = executor.next_done()
             job = inflight.pop(future)
-            outcome = _outcome(future)
+            outcome = outcome_of(future)
             job.attempts += 1
             if outcome[0] == "ok":
                 job.result, job.seconds = outcome[1], outcome[2]
@@ -600,7 +413,7 @@ def _table(
     pd: ModuleType,
     name: str,
     jobs: list[_Job],
-    executor: _InProcess | _Finished,
+    executor: Executor,
     store: SweepCache | None,
     resubmitted: int,
     seconds: float,

@@ -27,4 +27,6 @@ def every_backend(request, monkeypatch):
         monkeypatch.setattr(_numba, "_tried", True)
     elif not _numba.available():
         pytest.skip("numba is not installed or is hidden (the fast extra)")
+    else:  # "auto" then runs even a short event-driven run compiled from its first event
+        monkeypatch.setattr(_numba, "AUTO_PYTHON_EVENTS", 0)
     return request.param

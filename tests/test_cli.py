@@ -18,6 +18,7 @@ from discsim import cli
 CASES = ["missed_collision", "wrong_direction", "multiple_collisions", "delay"]
 
 
+@pytest.mark.slow  # about 10 s (the GIF); test_demo_without_gif_and_with_another_policy stays quick
 def test_demo_prints_the_table_and_writes_the_figures(tmp_path, capsys):
     out = tmp_path / "figures"
     assert cli.main(["demo", "--out", out]) == 0

@@ -236,6 +236,7 @@ def test_a_killed_cli_run_resumes_to_the_same_end(tmp_path):
     _assert_same_run(killed, straight)
 
 
+@pytest.mark.slow  # about 10 s: a benchmark script in its quick mode
 def test_longrun_benchmark_quick(tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     done = subprocess.run(

@@ -97,6 +97,7 @@ def test_plot_case_draws_pit_and_pic_side_by_side(tmp_path):
     assert_not_blank(plot.save_figure(fig, tmp_path / "case3.png"))
 
 
+@pytest.mark.slow  # about 6 s: a 61-frame GIF
 def test_animate_saves_a_gif_of_two_runs(tmp_path):
     case = ds.scenarios.delay()
     pic, pit = case_runs(case)

@@ -19,6 +19,9 @@ from discsim.model import Box
 
 __all__ = ["RDF", "Psi6", "pairs_within", "psi6", "rdf"]
 
+#: The default ``r_max`` of :func:`rdf`, in mean spacings ``sqrt(A / N)``: the first few shells at any density
+#: (a dense fluid's g(r) is within a few per cent of 1 beyond); the pair search costs ``N r_max^2`` per frame.
+_SHELLS = 5.0
 #: Candidate pairs handled at once (bounds the memory of the pair search: about 40 bytes a pair).
 _PAIR_BLOCK = 1 << 21
 
@@ -221,11 +224,16 @@ def rdf(positions, box: Box, r_max: float | None = None, dr: float | None = None
     Args:
         positions: ``(N, 2)`` or ``(T, N, 2)`` centres (length units).
         box: the box.
-        r_max: largest distance (default: the smaller of half the shorter side and 10 mean spacings
-            ``sqrt(A / N)``); at most half the shorter side of a periodic box, the shorter side with walls.
-        dr: bin width (default ``r_max / 200``); the bins are ``[0, dr), [dr, 2 dr), ...`` up to ``r_max``
-            (rounded down to whole bins). Choose ``dr = sigma / k`` to read the contact value.
-        radii: ``(N,)`` or one radius: with walls, the centres' margin from the walls (default 0: points).
+        r_max: largest distance (default: the smaller of the limit below and 5 mean spacings
+            ``sqrt(A / N)``, a few shells of neighbours at any density); at most half the shorter side of a
+            periodic box, the shorter side with walls. The cost grows as ``N r_max^2`` per frame.
+        dr: bin width (default: the contact distance ``2 * mean(radii)`` over 50 when ``radii`` are given, so
+            that it falls on a bin edge; else the mean spacing over 200, fine enough for
+            :meth:`RDF.contact_value` at any packing fraction above about 0.03; at least 20 bins); the bins are
+            ``[0, dr), [dr, 2 dr), ...`` up to ``r_max`` (rounded down to whole bins). Choose ``dr = sigma / k``
+            to read the contact value.
+        radii: ``(N,)`` or one radius (default 0: points): the disc size for the default ``dr``, and with
+            walls the centres' margin from the walls.
 
     Returns:
         :class:`RDF` (``r``, ``g``, ``counts``, ``contact_value(sigma)``, ``plot()``).
@@ -237,8 +245,8 @@ def rdf(positions, box: Box, r_max: float | None = None, dr: float | None = None
     Example:
         >>> import numpy as np, discsim as ds
         >>> box = ds.Box(10.0, 10.0, periodic=True)
-        >>> points = np.random.default_rng(0).uniform(0, 10, size=(20, 2000, 2))  # an ideal gas, 20 frames
-        >>> g = ds.rdf(points, box, r_max=4.0, dr=0.5).g
+        >>> points = np.random.default_rng(0).uniform(0, 10, size=(10, 1000, 2))  # an ideal gas, 10 frames
+        >>> g = ds.rdf(points, box, r_max=2.0, dr=0.5).g
         >>> bool(np.all(np.abs(g - 1) < 0.05))
         True
     """
@@ -250,13 +258,15 @@ def rdf(positions, box: Box, r_max: float | None = None, dr: float | None = None
         if dr > half:
             msg = f"the bin width dr={dr!r} is larger than half the box ({half!r}): no bin would fit"
             raise InvalidArgumentError(msg)
-    margin = float(np.mean(radii)) if not box.periodic else 0.0
-    if not (math.isfinite(margin) and margin >= 0.0) or 2 * margin >= min(box.width, box.height):
-        msg = f"radii must be >= 0 and leave room in the box, got a mean radius of {margin!r}"
+    radius = float(np.mean(radii))
+    if not (math.isfinite(radius) and radius >= 0.0) or 2 * radius >= min(box.width, box.height):
+        msg = f"radii must be >= 0 and leave room in the box, got a mean radius of {radius!r}"
         raise InvalidArgumentError(msg)
+    margin = 0.0 if box.periodic else radius
     limit = half if box.periodic else min(box.width, box.height) - 2.0 * margin
+    spacing = math.sqrt(box.area / n)  # the mean distance between neighbours
     if r_max is None:
-        r_max = min(limit, 10.0 * math.sqrt(box.area / n))
+        r_max = min(limit, _SHELLS * spacing)
         if dr is not None:
             r_max = max(r_max, min(dr, limit))
     else:
@@ -266,7 +276,7 @@ def rdf(positions, box: Box, r_max: float | None = None, dr: float | None = None
             msg = f"r_max={r_max!r} is beyond {where} ({limit!r})"
             raise InvalidArgumentError(msg)
     if dr is None:
-        dr = r_max / 200.0
+        dr = min(2.0 * radius / 50.0 if radius > 0.0 else spacing / 200.0, r_max / 20.0)  # 20 bins at least
     bins = max(1, math.floor(r_max / dr * (1 + 1e-12)))
     edges = dr * np.arange(bins + 1)
     top = float(edges[-1])

@@ -102,11 +102,17 @@ def test_psi6_of_a_fluid_is_small_and_frames_stack():
     assert p.order[0] == pytest.approx(ds.psi6(f.positions[0], f.box).order)
 
 
-def test_contact_value_gives_the_pressure():
+@pytest.fixture(scope="module")
+def fluid():
+    """An equilibrated hard-disc fluid at packing 0.5 (radius 1): the run, and 41 frames after the lattice melted."""
+    sim = ds.EventDriven(*ds.random_gas(1000, 0.5, seed=5)).run(until=24.0)
+    return sim, ds.frames(sim, np.arange(4.0, 24.01, 0.5))
+
+
+def test_contact_value_gives_the_pressure(fluid):
     """Z = 1 + 2 eta g(sigma+) against the run's own virial pressure and Henderson's equation of state."""
     eta, radius = 0.5, 1.0
-    sim = ds.EventDriven(*ds.random_gas(1000, eta, seed=5)).run(until=24.0)
-    f = ds.frames(sim, np.arange(4.0, 24.01, 0.5))  # after the lattice melted
+    sim, f = fluid
     g = ds.rdf(f.positions, f.box, r_max=4.0, dr=0.02)
     contact = g.contact_value(2.0 * radius)
     z_structure = 1.0 + 2.0 * eta * contact
@@ -115,6 +121,34 @@ def test_contact_value_gives_the_pressure():
     assert z_structure == pytest.approx(float(ds.henderson_z(eta)), rel=0.02)
     assert ds.compressibility_factor(sim, since=4.0) == pytest.approx(z_virial.z)
     assert g.g[g.r < 2.0].max() == 0.0  # hard discs never overlap
+
+
+@pytest.mark.parametrize("radii", [0.0, 1.0])
+def test_the_default_bins_give_the_contact_value(fluid, radii):
+    """``ds.rdf(positions, box).contact_value(sigma)`` works as it stands (the default bins were sigma / 8 wide
+    and held 2 bins in the fit window), and agrees with fine bins chosen by hand."""
+    _, f = fluid
+    by_hand = ds.rdf(f.positions, f.box, r_max=4.0, dr=0.02).contact_value(2.0)
+    default = ds.rdf(f.positions, f.box, radii=radii)
+    assert default.contact_value(2.0) == pytest.approx(by_hand, rel=0.01)
+    if radii:  # the disc size given: the contact distance on a bin edge
+        assert np.isclose(default.edges, 2.0, rtol=1e-12).any()
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+def test_the_defaults_at_ten_thousand_discs(periodic):
+    """N = 10^4 at the density of discs of radius 1 at packing 0.5: the default bins give the contact value
+    (an ideal gas: 1), and the default r_max is a few spacings, so the pairs counted (and the time) stay near
+    40 a disc per frame (10 spacings counted 157: 9.5 s for 11 frames)."""
+    n, sigma = 10_000, 2.0
+    side = math.sqrt(n * math.pi / 0.5)
+    box = ds.Box(side, side, periodic=periodic)
+    points = np.random.default_rng(4).uniform(0, side, size=(3, n, 2))
+    g = ds.rdf(points, box)
+    assert g.contact_value(sigma) == pytest.approx(1.0, abs=0.1)
+    spacing = math.sqrt(box.area / n)
+    assert g.edges[-1] <= 5.0 * spacing * (1 + 1e-12)
+    assert g.counts.sum() < 40 * n * 3
 
 
 def test_contact_value_needs_bins_in_the_window():

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from discsim._numba import resolve_backend
+from discsim._numba import auto_plan, available, mark_loaded, resolve_backend
 from discsim.cells import CellGrid
 from discsim.engines.base import Engine, register_engine
 from discsim.engines.event_driven.numba import NumbaBackend
@@ -58,8 +58,10 @@ class EventDriven(RunStops, Engine):
         pass_through: pairs of group labels (``discs.groups``) whose discs do
             not collide with each other, e.g. ``{(1, 1)}`` for bullets that
             pass through one another. Free when empty.
-        backend: the event loop: ``"auto"`` (the default: ``"numba"`` when numba
-            imports, else ``"python"``), ``"numba"`` (compiled, from the ``fast`` extra:
+        backend: the event loop: ``"auto"`` (the default: ``"python"`` for the first
+            ``discsim._numba.AUTO_PYTHON_EVENTS`` (20,000) physical events, then ``"numba"`` when numba is
+            installed, or ``"numba"`` from the start from ``AUTO_NUMBA_DISCS`` (20,000) discs on: a short run
+            does not pay for loading the compiled loop), ``"numba"`` (compiled, from the ``fast`` extra:
             ``pip install "discsim[fast]"``; :mod:`discsim.engines.event_driven.numba`) or
             ``"python"`` (pure Python; :mod:`discsim.engines.event_driven.python`). Both give the
             same events bit for bit and the same checkpoints; ``sim.backend`` names the one that runs.
@@ -110,12 +112,20 @@ class EventDriven(RunStops, Engine):
         if not isinstance(queue, str) or queue not in QUEUES:
             msg = f"queue must be one of {sorted(QUEUES)}, got {queue!r}"
             raise InvalidArgumentError(msg)
-        backend = resolve_backend(backend, BACKENDS, "EventDriven")
+        self._auto = isinstance(backend, str) and backend == "auto"
+        #: physical events the Python loop still runs before ``"auto"`` takes the compiled one (None: no switch)
+        self._auto_events: int | None = None
+        if self._auto:
+            backend, self._auto_events = auto_plan(len(scene))
+        else:
+            backend = resolve_backend(backend, BACKENDS, "EventDriven")
         super().__init__(scene, record)
         grid = self.grid = self.cell_grid(scene.discs.radii, scene.box, cell_size)
         self.queue_kind = queue
         self.cell_size = cell_size
         self._backend = BACKENDS[backend](scene, grid, queue)
+        if backend == "numba":
+            mark_loaded()
 
     @staticmethod
     def cell_grid(radii: np.ndarray, box: Box, cell_size: float | None = None) -> CellGrid:
@@ -150,7 +160,7 @@ class EventDriven(RunStops, Engine):
             "record": self.record,
             "queue": self.queue_kind,
             "cell_size": self.cell_size,
-            "backend": self.backend,
+            "backend": "auto" if self._auto else self.backend,  # "auto" chooses again when loaded
             "edits": self._edits,
         }
 
@@ -222,10 +232,25 @@ class EventDriven(RunStops, Engine):
         self.grid, self._backend = grid, backend
         self._jam_mark = self._jam_counts = self._jam_scale = None  # new discs: the jam guard starts afresh
 
+    def _take_compiled(self) -> None:
+        """``backend="auto"`` after its Python events: the compiled loop goes on from the Python loop's state.
+
+        The state crosses as a checkpoint's does, so the events that follow are the same bit for bit. If numba
+        fails to import after all, the Python loop goes on.
+        """
+        self._auto_events = None
+        if not available():
+            return
+        old = self._backend
+        compiled = BACKENDS["numba"](self.scene, self.grid, self.queue_kind)
+        compiled.load(old.export())
+        self._backend = compiled
+        mark_loaded()
+
     # --- the user's protocol -------------------------------------------------------------
     @property
     def backend(self) -> str:
-        """The name of the backend that runs the event loop."""
+        """The name of the backend that runs the event loop now (under ``"auto"``: ``"python"``, then ``"numba"``)."""
         return self._backend.name
 
     @property

@@ -33,6 +33,7 @@ class RunStops:
 
     # What the engine provides (declared for readers and the type checker).
     _backend: Backend
+    _auto_events: int | None
     _broken: str | None
     _logging: bool
     _log: EventLog
@@ -47,6 +48,7 @@ class RunStops:
         # come before the engine's in the method order)
 
         def _units(self) -> int: ...
+        def _take_compiled(self) -> None: ...
         def snapshot(self) -> Discs: ...
         def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene, last=None) -> None: ...
 
@@ -79,18 +81,17 @@ class RunStops:
         When it finds one, ``time`` goes back to the last collision or wall hit
         (or to where the call started): the crossings after it changed nothing.
         """
-        backend = self._backend
         done, start = 0, self.time
         budget = 64 + 16 * len(self.discs)
-        while True:
-            crossings = backend.counts()["cell_crossings"]
+        while True:  # (self._backend each time: "auto" may have taken the compiled loop inside _chunked)
+            crossings = self._backend.counts()["cell_crossings"]
             k = self._chunked(INF, None if limit is None else limit - done, log, budget)
             done += k
-            if done == limit or backend.counts()["cell_crossings"] - crossings < budget:
+            if done == limit or self._backend.counts()["cell_crossings"] - crossings < budget:
                 return done  # the event limit, or nothing left in the queue
             if k == 0:
                 if self._never_again():
-                    last = backend.last_event() if done else None  # done > 0: there is one
+                    last = self._backend.last_event() if done else None  # done > 0: there is one
                     self._rewind(start if last is None else last[0])
                     return done
                 budget *= 2
@@ -153,9 +154,16 @@ class RunStops:
             seen, half = units - mark[1], mark[2] // 2
             room = half - seen if seen < half else mark[2] - seen  # stop half-way, and at the threshold
             ask = room if limit is None else min(room, limit - done)
+            if self._auto_events is not None:  # backend="auto": the Python loop until the compiled one pays
+                ask = min(ask, max(self._auto_events, 1))
             crossed = backend.counts()["cell_crossings"] if crossings is not None else 0
             k = backend.advance(until, ask, log, left)
             done += k
+            if self._auto_events is not None:
+                self._auto_events -= k
+                if self._auto_events <= 0:
+                    self._take_compiled()
+                    backend = self._backend
             units = self._units()
             if backend.time - mark[0] > window:
                 self._jam_mark, self._jam_counts = (backend.time, units, chunk, False), None

@@ -50,6 +50,7 @@ def assert_identical(a, b):
 def test_auto_takes_numba_when_it_imports(monkeypatch):
     discs, box = ds.random_gas(30, 0.3, seed=1)
     expected = "numba" if _numba.available() else "python"
+    monkeypatch.setattr(_numba, "AUTO_PYTHON_EVENTS", 0)  # (a short run's "auto": see the tests below)
     assert ds.EventDriven(discs, box).backend == expected
     monkeypatch.setattr(_numba, "_module", None)
     monkeypatch.setattr(_numba, "_tried", True)
@@ -70,6 +71,70 @@ def test_hiding_numba_by_the_environment_gives_the_python_backend():
     first, second = out.stdout.splitlines()
     assert first == "python"
     assert "hidden by DISCSIM_NO_NUMBA" in second and "discsim[fast]" in second
+
+
+def test_a_short_auto_run_does_not_load_numba():
+    """The README's five-liner under "auto" in a fresh process: importing numba and loading the compiled loop
+    from its cache cost it about a second (more than the run), so its 10,000 events run in pure Python."""
+    code = (
+        "import sys, discsim as ds\n"
+        "sim = ds.EventDriven(*ds.random_gas(1000, 0.4, periodic=True, seed=0)).run(until=10.0)\n"
+        "print(sim.backend, 'numba' in sys.modules, sim.counts['collisions'] < 20_000)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "DISCSIM_NO_NUMBA"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT, check=True)
+    assert out.stdout.split() == ["python", "False", "True"]
+
+
+@pytest.fixture
+def fresh_auto(monkeypatch):
+    """A process that has not loaded the compiled loop, with "auto" switching after 3,000 events."""
+    monkeypatch.setattr(_numba, "_loaded", False)
+    monkeypatch.setattr(_numba, "AUTO_PYTHON_EVENTS", 3000)
+
+
+@needs_numba
+@pytest.mark.parametrize("periodic", [True, False])
+@pytest.mark.parametrize("how", ["until", "events", "steps"])
+def test_auto_takes_the_compiled_loop_mid_run_with_the_same_events(fresh_auto, periodic, how):
+    discs, box = ds.random_gas(400, 0.5, periodic=periodic, seed=8)
+    auto = ds.EventDriven(discs, box)
+    assert auto.backend == "python"
+    reference = ds.EventDriven(discs, box, backend="python")
+    for sim in (auto, reference):
+        if how == "until":
+            sim.run(until=12.0)  # about 10,000 events
+        elif how == "events":
+            sim.run(events=10_000)  # no time limit: the open-ended loop
+        else:
+            sim.run(events=2990)
+            for _ in range(20):  # one event at a time across the switch
+                sim.step()
+            sim.run(events=5000)
+    assert auto.backend == "numba" and auto.counts["collisions"] > 3000
+    assert_identical(auto, reference)
+    auto._check()
+    # the process has loaded the compiled loop now: the next "auto" engine takes it at once
+    assert ds.EventDriven(discs, box).backend == "numba"
+
+
+@needs_numba
+def test_auto_takes_the_compiled_loop_at_once_for_many_discs(fresh_auto, monkeypatch):
+    discs, box = ds.random_gas(400, 0.5, seed=8)
+    assert ds.EventDriven(discs, box).backend == "python"
+    monkeypatch.setattr(_numba, "AUTO_NUMBA_DISCS", 400)
+    assert ds.EventDriven(discs, box).backend == "numba"
+
+
+def test_an_auto_run_saved_and_loaded_stays_auto(fresh_auto, tmp_path):
+    discs, box = ds.random_gas(400, 0.5, seed=8)
+    whole = ds.EventDriven(discs, box, backend="python").run(events=8000)
+    half = ds.EventDriven(discs, box).run(events=2000)
+    copy = ds.load(half.save(tmp_path / "half.dsc"))
+    assert copy._settings()["backend"] == "auto" and copy.backend == "python"
+    copy.run(events=6000)  # 3,000 more in Python, then compiled where numba is installed
+    assert copy.backend == ("numba" if _numba.available() else "python")
+    assert_identical(whole, copy)
 
 
 # --- the same events -----------------------------------------------------------------------------------
@@ -129,9 +194,11 @@ def test_a_large_renumbered_system_and_epoch_moves_are_identical():
 
 @needs_numba
 @pytest.mark.parametrize("name", sorted(n for n in os.listdir(GOLDEN) if n.startswith("ed_") and "5000" not in n))
-def test_golden_scenes_under_numba(name):
+def test_golden_scenes_under_numba(name, monkeypatch):
     """The golden logs recorded before the redesign, replayed by the compiled loop."""
     import importlib.util
+
+    monkeypatch.setattr(_numba, "AUTO_PYTHON_EVENTS", 0)  # "auto" compiled from the first event
 
     spec = importlib.util.spec_from_file_location("make_golden", GOLDEN / "make_golden.py")
     make_golden = importlib.util.module_from_spec(spec)

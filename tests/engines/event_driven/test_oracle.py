@@ -27,8 +27,8 @@ def _lockstep_times(sim, steps):
 
 
 @pytest.mark.parametrize("periodic", [False, True])
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_equal_discs_follow_the_oracle(periodic, seed):
+@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)])
+def test_equal_discs_follow_the_oracle(periodic, seed):  # seed 0 quick; 1 and 2 (3 s each) repeat it: slow
     discs, box = ds.random_gas(40, 0.35, periodic=periodic, seed=seed)
     _lockstep_times(ds.EventDriven(discs, box), 300)
 

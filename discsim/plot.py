@@ -132,7 +132,9 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
     colours = _disc_colours(discs.masses)
     _circles(ax, positions, discs.radii, colours)
     if arrows:
-        _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
+        quiver = _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
+        if quiver is not None and box is not None:  # arrows end at the walls, as the discs do
+            quiver.set_clip_path(Rectangle((0.0, 0.0), box.width, box.height, transform=ax.transData))
     _setup(ax, box)
     if box is None and len(positions):
         r = float(discs.radii.max())

@@ -7,6 +7,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
+import matplotlib.quiver
 import numpy as np
 import pytest
 from matplotlib import animation
@@ -54,6 +55,18 @@ def test_plot_state_of_discs_and_of_an_engine(tmp_path):
     assert plot.plot_state(sim, ax=given) is given
     assert "t = 0.5" in given.get_title()
     assert_not_blank(plot.save_figure(fig, tmp_path / "sim.png"))
+
+
+def test_plot_state_clips_velocity_arrows_at_the_box():
+    # A fast disc next to the right wall: its arrow (four radii long) would reach past the box.
+    discs = ds.Discs([[7.0, 2.0], [2.0, 2.0]], [[3.0, 0.0], [0.5, 0.0]], radii=0.8)
+    ax = plot.plot_state(discs, box=ds.Box(8.0, 4.0))
+    (quiver,) = [c for c in ax.collections if isinstance(c, matplotlib.quiver.Quiver)]
+    assert quiver.U[0] + quiver.X[0] > 8.0  # drawn to scale, it leaves the box ...
+    ax.figure.canvas.draw()
+    clip = quiver.get_clip_box()  # ... so it is cut at the walls (matplotlib keeps a rectangle as a box)
+    bounds = ax.transData.inverted().transform(clip.get_points())
+    np.testing.assert_allclose([bounds.min(axis=0), bounds.max(axis=0)], [[0.0, 0.0], [8.0, 4.0]], atol=1e-9)
 
 
 def test_plot_trajectories_draws_one_path_per_disc(tmp_path):

@@ -181,3 +181,35 @@ def test_case_figures_are_readable_zoomed_and_never_stack_labels():
     obstacle = pic.discs.positions[np.isinf(pic.discs.masses)][0]
     for ax in fig.axes:
         assert all(np.hypot(*(np.array(t.get_position()) - obstacle)) > 0.5 for t in ax.texts)
+
+
+def test_animate_draws_small_discs_large_with_the_clock_and_arrows_clear_of_them(tmp_path):
+    case = ds.scenarios.missed_collision()  # discs of radius 0.2 in a 20 x 10 box
+    pic, pit = case_runs(case)
+    path = tmp_path / "case1.gif"
+    anim = plot.animate([pit, pic], path, arrows=True, dpi=80)
+    fig = anim._fig
+    ax = fig.axes[0]
+    pixels_per_unit = np.diff(ax.transData.transform([[0.0, 0.0], [1.0, 0.0]]), axis=0)[0, 0] * 80 / fig.dpi
+    assert 2 * 0.2 * pixels_per_unit > 9  # a disc over 9 pixels wide (4.6 when the whole box was shown)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 61 and gif.size[0] == round(fig.get_figwidth() * 80)
+    (clock,) = [t for t in ax.texts if t.get_text().startswith("t = ")]
+    assert clock.get_position()[1] > 1.0  # above the panel, not over the discs
+    assert ax.get_xlabel() == "x" and ax.get_ylabel() == "y"
+    # One arrow per disc, along its velocity at the last frame.
+    for panel, sim in zip(fig.axes, (pit, pic), strict=True):
+        (quiver,) = [c for c in panel.collections if isinstance(c, matplotlib.quiver.Quiver)]
+        np.testing.assert_allclose(quiver.get_offsets(), sim.positions)
+        arrows = np.column_stack([quiver.U, quiver.V])
+        np.testing.assert_allclose(arrows / np.abs(arrows).max(), sim.velocities / np.abs(sim.velocities).max())
+    plot.close(anim)
+    # The whole box, when asked.
+    whole = plot.animate(pic, zoom=False)
+    assert whole._fig.axes[0].get_xlim()[1] > case.box.width
+    plot.close(whole)
+
+
+def test_state_figures_name_their_axes():
+    ax = plot.plot_state(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], radii=0.5), box=ds.Box(4.0, 3.0))
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x", "y")

@@ -178,8 +178,8 @@ def _log_source(source, what: str):
     from discsim.io.streams import StreamedEvents, iter_events
 
     if isinstance(source, (str, Path)):  # read chunk by chunk, never whole
-        log = iter_events(source)
-        return log.record_arrays, log.discs, log.box, log.start_time, log.end_time, None
+        chunked = iter_events(source)
+        return chunked.record_arrays, chunked.discs, chunked.box, chunked.start_time, chunked.end_time, None
     if isinstance(source, StreamedEvents):
         log = source
         return (lambda: iter([log.events])), log.discs, log.box, log.start_time, log.end_time, None

@@ -30,6 +30,7 @@ from matplotlib.patches import Circle, Rectangle
 from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION
 from discsim.model import Discs, frame_count
+from discsim.trajectory import LastRecords, replay
 
 __all__ = ["animate", "close", "plot_case", "plot_cases", "plot_state", "plot_trajectories", "save_figure"]
 
@@ -574,24 +575,17 @@ def animate(
     for ax, s, paths in zip(axes[0], sims, paths_of, strict=True):
         colours = _disc_colours(s.discs.masses)
         # One collection of circles per panel, moved each frame (its offsets), not one patch per disc.
-        diameters = 2.0 * np.asarray(s.discs.radii, dtype=float)
-        discs = EllipseCollection(
-            diameters,
-            diameters,
-            np.zeros(len(diameters)),
-            units="xy",  # sizes in data units: discs to scale
-            offsets=np.zeros((len(diameters), 2)),
-            offset_transform=ax.transData,
-            facecolors=colours,
-            edgecolors=colours,
-            alpha=0.75,
-            zorder=2,
+        d = 2.0 * np.asarray(s.discs.radii, dtype=float)
+        style: dict[str, Any] = {"facecolors": colours, "edgecolors": colours, "alpha": 0.75, "zorder": 2}
+        discs = ax.add_collection(  # sizes in data units ("xy"): the discs to scale
+            EllipseCollection(d, d, 0 * d, units="xy", offsets=paths[0], offset_transform=ax.transData, **style)
         )
-        ax.add_collection(discs)
         dynamic.append(discs)
         quiver = None
         if arrows:
-            speeds = _frame_velocities(s, times)
+            start, ids = s.run_context.log_origin(s.discs)  # velocities: each disc's last recorded one
+            origin = LastRecords.at_start(start, float(s.start_time), ids)
+            speeds = replay([s.events], origin, times, s.box, velocities=True)[1]
             scale = _arrow_time(s.discs.radii, speeds.reshape(-1, 2)[np.isfinite(speeds.reshape(-1, 2)).all(axis=1)])
             quiver = _arrows(ax, np.nan_to_num(paths[0]), np.nan_to_num(speeds[0]) * 0.0, max(scale, 1e-300), colours)
             dynamic.append(quiver)
@@ -639,16 +633,6 @@ def animate(
             # matplotlib's stubs ask for an int, but the writer takes any positive frame rate.
             anim.save(str(path), writer=animation.FFMpegWriter(fps=fps), dpi=dpi)  # type: ignore[arg-type]
     return anim
-
-
-def _frame_velocities(sim, times) -> np.ndarray:
-    """``(T, N, 2)`` each disc's velocity at ``times``: its last recorded one (NaN where it is not there)."""
-    from discsim.trajectory import LastRecords, replay
-
-    discs, ids = sim.run_context.log_origin(sim.discs)
-    origin = LastRecords.at_start(discs, float(sim.start_time), ids)
-    _, speeds = replay([sim.events], origin, times, sim.box, velocities=True)
-    return speeds[:, : len(sim.discs.radii)] if ids is None else speeds[:, np.asarray(sim.ids)]
 
 
 def _save_gif(fig, update, dynamic, count: int, path: Path, fps: float, dpi: int) -> None:

@@ -274,7 +274,9 @@ def _image_counts(disc, t_rec, state, starts, size, images0=None) -> np.ndarray:
     x, y, _, _ = advance(state[:-1, 0], state[:-1, 1], state[:-1, 2], state[:-1, 3], t_rec[1:] - t_rec[:-1])
     flown = np.column_stack([x, y])
     steps = np.nan_to_num(image_steps(flown, state[1:, :2], size))  # NaN: not there yet, or gone
-    steps[np.isin(np.arange(1, len(state)), starts)] = 0.0  # the first record of the next disc
+    first = np.zeros(len(state) + 1, dtype=bool)
+    first[starts] = True
+    steps[first[1:-1]] = 0.0  # the first record of the next disc
     counts = np.zeros_like(state[:, :2])
     counts[1:] = np.cumsum(steps, axis=0)
     counts -= np.repeat(counts[starts[:-1]], np.diff(starts), axis=0)  # each disc starts from zero

@@ -235,6 +235,9 @@ def _read_span(run: _Run, t0: float, t1: float, limit: int) -> tuple[_Span, bool
         times = records["time"]
         if times.min() > t1:
             break
+        if times.max() < t0:  # wholly before the span: only where it leaves each disc
+            before = before.after(records)
+            continue
         early = times < t0
         if early.any():
             before = before.after(records[early])

@@ -16,6 +16,11 @@ all of it:
 
 To compare two versions of discsim, run the script under each (``PYTHONPATH=OTHER/checkout python
 benchmarks/streamed_log.py --log ...``): the tasks use only names both have. Writes ``streamed_log.csv``.
+
+Measured (``benchmarks/results/streamed_log.csv``, and ``streamed_log_before.csv`` for the commit before the
+chunked readers, 7bdeb11), 7,010,478 events, 2 shared cores: ``view`` 34.7 s and 2,863 MB before, 2.1 s and
+51 MB after; ``trajectory`` 36.6 s and 3,271 MB before, 1.1 s and 52 MB after; ``frames`` 41.9 s and 3,907 MB
+before, 3.2 s and 53 MB after (the whole log in memory takes 1,231 MB).
 """
 
 from __future__ import annotations
@@ -81,10 +86,12 @@ def main(argv=None) -> list[dict]:
         log = write_log(Path(tempfile.mkdtemp(prefix="discsim-log-")), n, until)
     import discsim as ds
 
-    header = ds.read_events if not hasattr(ds, "iter_events") else ds.iter_events
-    info = header(log)
-    end = float(info.end_time)
-    events = int(info.records) if hasattr(info, "records") and not hasattr(info, "events") else len(info.events)
+    if hasattr(ds, "iter_events"):  # the header alone
+        chunked = ds.iter_events(log)
+        end, events = chunked.end_time, chunked.records
+    else:  # a discsim from before iter_events
+        whole = ds.read_events(log)
+        end, events = whole.end_time, len(whole.events)
     start = math.floor(0.75 * end * 2) / 2  # three quarters in, on a half unit
     rows = []
     for task in ("view", "trajectory", "frames", "read whole"):

@@ -588,7 +588,9 @@ def animate(
             speeds = replay([s.events], origin, times, s.box, velocities=True)[1]
             scale = _arrow_time(s.discs.radii, speeds.reshape(-1, 2)[np.isfinite(speeds.reshape(-1, 2)).all(axis=1)])
             quiver = _arrows(ax, np.nan_to_num(paths[0]), np.nan_to_num(speeds[0]) * 0.0, max(scale, 1e-300), colours)
-            dynamic.append(quiver)
+            if quiver is not None:  # cut at the walls, as in plot_state
+                quiver.set_clip_path(Rectangle((0.0, 0.0), s.box.width, s.box.height, transform=ax.transData))
+                dynamic.append(quiver)
             speeds = speeds * scale
         if len(sims) > 1:
             for truth in truths:

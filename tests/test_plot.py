@@ -203,6 +203,8 @@ def test_animate_draws_small_discs_large_with_the_clock_and_arrows_clear_of_them
         np.testing.assert_allclose(quiver.get_offsets(), sim.positions)
         arrows = np.column_stack([quiver.U, quiver.V])
         np.testing.assert_allclose(arrows / np.abs(arrows).max(), sim.velocities / np.abs(sim.velocities).max())
+        box = panel.transData.inverted().transform(quiver.get_clip_box().get_points())
+        np.testing.assert_allclose(box, [[0.0, 0.0], [case.box.width, case.box.height]], atol=1e-9)  # cut at the walls
     plot.close(anim)
     # The whole box, when asked.
     whole = plot.animate(pic, zoom=False)

@@ -273,7 +273,8 @@ def iter_events(
 
     Raises:
         FileNotFoundError: if there is no such file.
-        InvalidArgumentError: for a ``chunk`` that is not a positive integer.
+        InvalidArgumentError: for a ``chunk`` that is not a positive integer, or a ``start`` that is not a
+            finite time.
         CheckpointError: see :func:`read_events` (a damaged chunk when it is reached).
 
     Example:
@@ -293,11 +294,15 @@ def iter_events(
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         msg = f"chunk must be a positive integer (records per chunk), got {chunk!r}"
         raise InvalidArgumentError(msg)
+    if start is not None and not (isinstance(start, (int, float, np.number)) and np.isfinite(start)):
+        msg = f"start must be a finite time or None, got {start!r}"
+        raise InvalidArgumentError(msg)
     path = Path(path)
     meta, arrays, chunks = stream_index(path, partial=partial)
     discs, box, start_time, run_id, ids = _header(path, meta, arrays)
     end_time = float(chunks[-1].get("time", start_time)) if chunks else start_time
     total = sum(int(c.get("count", 0)) for c in chunks)
+    start = None if start is None else float(start)
     return EventChunks(
         path, discs, ids, box, start_time, end_time, run_id, total, int(chunk), start, unwrapped, partial
     )

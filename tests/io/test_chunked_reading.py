@@ -103,8 +103,11 @@ def test_the_before_state_of_a_walled_log_with_ties_matches_the_whole_log(tmp_pa
     assert chunked.tobytes() == whole.trajectory(times).tobytes()
 
 
-def test_a_bad_chunk_size_is_refused_by_name(tmp_path):
+def test_a_bad_chunk_size_or_start_is_refused_by_name(tmp_path):
     path, _ = _streamed(tmp_path, until=0.5)
     for bad in (0, -3, 2.5, True):
         with pytest.raises(ds.InvalidArgumentError, match="chunk must be a positive integer"):
             ds.iter_events(path, chunk=bad)
+    for bad in (float("nan"), float("inf"), "1.0"):
+        with pytest.raises(ds.InvalidArgumentError, match="start must be a finite time"):
+            ds.iter_events(path, start=bad)

@@ -28,7 +28,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION
+from discsim.events import ADD, COLLISION
 from discsim.model import Discs, frame_count
 from discsim.trajectory import LastRecords, replay
 
@@ -573,9 +573,12 @@ def animate(
     truths = [s for s in sims if type(s).__name__ == "EventDriven"]
     panels, outlines, dynamic = [], [], []
     for ax, s, paths in zip(axes[0], sims, paths_of, strict=True):
-        colours = _disc_colours(s.discs.masses)
+        start, ids = s.run_context.log_origin(s.discs)  # the log names discs by id: one column each
+        origin = LastRecords.at_start(start, float(s.start_time), ids)
+        scene = origin.after(s.events[s.events["kind"] == ADD]).grown(paths.shape[1])  # with the discs added
+        colours = _disc_colours(np.nan_to_num(scene.masses, nan=1.0))
         # One collection of circles per panel, moved each frame (its offsets), not one patch per disc.
-        d = 2.0 * np.asarray(s.discs.radii, dtype=float)
+        d = 2.0 * np.nan_to_num(scene.radii)
         style: dict[str, Any] = {"facecolors": colours, "edgecolors": colours, "alpha": 0.75, "zorder": 2}
         discs = ax.add_collection(  # sizes in data units ("xy"): the discs to scale
             EllipseCollection(d, d, 0 * d, units="xy", offsets=paths[0], offset_transform=ax.transData, **style)
@@ -583,9 +586,7 @@ def animate(
         dynamic.append(discs)
         quiver = None
         if arrows:
-            start, ids = s.run_context.log_origin(s.discs)  # velocities: each disc's last recorded one
-            origin = LastRecords.at_start(start, float(s.start_time), ids)
-            speeds = replay([s.events], origin, times, s.box, velocities=True)[1]
+            speeds = replay([s.events], origin, times, s.box, velocities=True)[1]  # last recorded velocities
             scale = _arrow_time(s.discs.radii, speeds.reshape(-1, 2)[np.isfinite(speeds.reshape(-1, 2)).all(axis=1)])
             quiver = _arrows(ax, np.nan_to_num(paths[0]), np.nan_to_num(speeds[0]) * 0.0, max(scale, 1e-300), colours)
             if quiver is not None:  # cut at the walls, as in plot_state

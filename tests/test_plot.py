@@ -6,6 +6,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import matplotlib.collections
 import matplotlib.pyplot as plt
 import matplotlib.quiver
 import numpy as np
@@ -215,3 +216,26 @@ def test_animate_draws_small_discs_large_with_the_clock_and_arrows_clear_of_them
 def test_state_figures_name_their_axes():
     ax = plot.plot_state(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], radii=0.5), box=ds.Box(4.0, 3.0))
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("x", "y")
+
+
+def test_animate_follows_discs_that_come_and_go():
+    discs, box = ds.random_gas(12, 0.2, seed=4)
+    sim = ds.EventDriven(discs, box).run(until=1.0)
+    sim.remove_discs([2, 5])
+    spots = ([x, y] for x in np.linspace(1.0, box.width - 1.0, 15) for y in np.linspace(1.0, box.height - 1.0, 15))
+    spot = next(p for p in spots if (np.hypot(*(sim.positions - p).T) > sim.discs.radii + 0.6).all())
+    sim.add_discs(ds.Discs([spot], [[1.0, -0.5]], 0.5))
+    sim.run(until=2.0)
+    anim = plot.animate(sim, times=[2.0, 0.5], arrows=True)  # the figure shows the first time, 2.0
+    (collection,) = [
+        c for c in anim._fig.axes[0].collections if isinstance(c, matplotlib.collections.EllipseCollection)
+    ]
+    expected = sim.trajectory([2.0])[0]
+    offsets = np.asarray(collection.get_offsets())
+    assert len(offsets) == len(expected) == 13  # one circle per disc id, the one added included
+    shown = np.isfinite(expected).all(axis=1)
+    np.testing.assert_allclose(offsets[shown], expected[shown])
+    assert (offsets[~shown] > 1e8).all() and (~shown).sum() == 2  # the removed discs: moved out of sight
+    # Each circle has its disc's size: the added one (id 12) its radius 0.5 (get_widths: full widths).
+    np.testing.assert_allclose(collection.get_widths(), 2.0 * np.append(discs.radii, 0.5))
+    plot.close(anim)

@@ -51,7 +51,7 @@ from discsim.errors import (
 from discsim.events import EVENT_DTYPE, Event, EventKind
 from discsim.io.checkpoints import checkpoint_info, load, resume
 from discsim.io.gsd import read_gsd, write_gsd
-from discsim.io.streams import StreamedEvents, read_events, trajectory_from_events
+from discsim.io.streams import StreamedEvents, iter_events, read_events, trajectory_from_events
 from discsim.io.xyz import read_xyz, write_xyz
 from discsim.model import Box, Discs, Segment, polygon
 from discsim.run import driver as _driver  # noqa: F401 (it provides Engine.run: discsim.engines.base.provide)
@@ -132,6 +132,7 @@ __all__ = [
     "free_times",
     "head_on",
     "henderson_z",
+    "iter_events",
     "load",
     "msd",
     "newtons_cradle",

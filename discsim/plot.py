@@ -22,14 +22,15 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import animation
-from matplotlib.collections import PatchCollection
+from matplotlib.collections import EllipseCollection, PatchCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION
+from discsim.events import ADD, COLLISION
 from discsim.model import Discs, frame_count
+from discsim.trajectory import LastRecords, replay
 
 __all__ = ["animate", "close", "plot_case", "plot_cases", "plot_state", "plot_trajectories", "save_figure"]
 
@@ -54,6 +55,8 @@ def _axes(ax, figsize=(6.0, 4.5)):
 
 def _setup(ax, box) -> None:
     ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
     if box is None:
         ax.autoscale_view()
         return
@@ -132,7 +135,9 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
     colours = _disc_colours(discs.masses)
     _circles(ax, positions, discs.radii, colours)
     if arrows:
-        _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
+        quiver = _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
+        if quiver is not None and box is not None:  # arrows end at the walls, as the discs do
+            quiver.set_clip_path(Rectangle((0.0, 0.0), box.width, box.height, transform=ax.transData))
     _setup(ax, box)
     if box is None and len(positions):
         r = float(discs.radii.max())
@@ -489,12 +494,23 @@ def _contact_outlines(ax, truth, colours, linestyle):
     return out
 
 
-def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max_frames: int = 200, title=None):
+def animate(
+    sim,
+    path=None,
+    *,
+    times=None,
+    fps: float = 10.0,
+    dpi: int = 80,
+    max_frames: int = 200,
+    title=None,
+    arrows: bool = False,
+    zoom: bool = True,
+):
     """Animate one run, or several side by side, from their event logs.
 
-    The time is written inside the first panel (with the frame number on a PIT frame time), and the
-    collisions of the event-driven runs are outlined from their time on (solid on their own panel,
-    dashed on the others, as in :func:`plot_case`).
+    The time is written above the first panel, clear of the discs (with the frame number on a PIT frame
+    time), and the collisions of the event-driven runs are outlined from their time on (solid on their own
+    panel, dashed on the others, as in :func:`plot_case`).
 
     Args:
         sim: an engine, or a sequence of engines over the same box (e.g.
@@ -507,6 +523,9 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
         dpi: resolution of a saved movie.
         max_frames: cap on the default number of frames.
         title: figure title.
+        arrows: draw each disc's velocity as an arrow (the fastest is four radii of the largest disc long).
+        zoom: show only the part of the box the discs visit (with a margin, as :func:`plot_case` does),
+            so that small discs in a large box are drawn large enough to see; False shows the whole box.
 
     Returns:
         The ``matplotlib.animation.FuncAnimation``.
@@ -540,63 +559,110 @@ def animate(sim, path=None, *, times=None, fps: float = 10.0, dpi: int = 80, max
     else:
         times, dt = np.atleast_1d(np.asarray(times, dtype=float)), 0.0
     box = sims[0].box
-    aspect = box.height / box.width
+    paths_of = [s.trajectory(times) for s in sims]
+    radii = np.concatenate([np.asarray(s.discs.radii, dtype=float) for s in sims])
+    if zoom:
+        seen = [p[np.isfinite(p).all(axis=-1)] for p in paths_of]
+        limits = _case_limits(seen, radii, box, min_aspect=0.5)
+    else:
+        pad = 0.02 * max(box.width, box.height)
+        limits = (-pad, box.width + pad, -pad, box.height + pad)
+    aspect = (limits[3] - limits[2]) / (limits[1] - limits[0])
     width = 4.5 * len(sims)
-    fig, axes = plt.subplots(1, len(sims), figsize=(width, max(2.5, 4.5 * aspect + 0.8)), squeeze=False)
+    fig, axes = plt.subplots(1, len(sims), figsize=(width, max(2.5, 4.5 * aspect + 0.9)), squeeze=False)
     truths = [s for s in sims if type(s).__name__ == "EventDriven"]
-    panels, outlines = [], []
-    for ax, s in zip(axes[0], sims, strict=True):
-        paths = s.trajectory(times)
-        colours = _disc_colours(s.discs.masses)
-        circles = [
-            Circle(tuple(paths[0, i]), float(r), facecolor=c, edgecolor=c, alpha=0.75)
-            for i, (r, c) in enumerate(zip(s.discs.radii, colours, strict=True))
-        ]
-        for c in circles:
-            ax.add_patch(c)
+    panels, outlines, dynamic = [], [], []
+    for ax, s, paths in zip(axes[0], sims, paths_of, strict=True):
+        start, ids = s.run_context.log_origin(s.discs)  # the log names discs by id: one column each
+        origin = LastRecords.at_start(start, float(s.start_time), ids)
+        scene = origin.after(s.events[s.events["kind"] == ADD]).grown(paths.shape[1])  # with the discs added
+        colours = _disc_colours(np.nan_to_num(scene.masses, nan=1.0))
+        # One collection of circles per panel, moved each frame (its offsets), not one patch per disc.
+        d = 2.0 * np.nan_to_num(scene.radii)
+        style: dict[str, Any] = {"facecolors": colours, "edgecolors": colours, "alpha": 0.75, "zorder": 2}
+        discs = ax.add_collection(  # sizes in data units ("xy"): the discs to scale
+            EllipseCollection(d, d, 0 * d, units="xy", offsets=paths[0], offset_transform=ax.transData, **style)
+        )
+        dynamic.append(discs)
+        quiver = None
+        if arrows:
+            speeds = replay([s.events], origin, times, s.box, velocities=True)[1]  # last recorded velocities
+            scale = _arrow_time(s.discs.radii, speeds.reshape(-1, 2)[np.isfinite(speeds.reshape(-1, 2)).all(axis=1)])
+            quiver = _arrows(ax, np.nan_to_num(paths[0]), np.nan_to_num(speeds[0]) * 0.0, max(scale, 1e-300), colours)
+            if quiver is not None:  # cut at the walls, as in plot_state
+                quiver.set_clip_path(Rectangle((0.0, 0.0), s.box.width, s.box.height, transform=ax.transData))
+                dynamic.append(quiver)
+            speeds = speeds * scale
         if len(sims) > 1:
             for truth in truths:
                 outlines += _contact_outlines(ax, truth, colours, "-" if truth is s else "--")
         _setup(ax, s.box)
-        ax.set_title(type(s).__name__, fontsize=10)
-        panels.append((paths, circles))
+        ax.set_xlim(limits[0], limits[1])
+        ax.set_ylim(limits[2], limits[3])
+        ax.set_title(type(s).__name__, fontsize=10, loc="left")
+        panels.append((paths, discs, quiver, speeds if arrows else None))
+    dynamic += [patch for _, patch in outlines]
     clock = axes[0][0].text(
-        0.02,
-        0.98,
-        "",
-        transform=axes[0][0].transAxes,
-        ha="left",
-        va="top",
-        fontsize=9,
-        zorder=6,
-        bbox={"boxstyle": "round,pad=0.2", "facecolor": "white", "edgecolor": "0.7", "alpha": 0.85},
-    )
+        1.0, 1.02, "", transform=axes[0][0].transAxes, ha="right", va="bottom", fontsize=9, zorder=6
+    )  # above the panel: never over the discs
+    dynamic.append(clock)
     if title:
         fig.suptitle(title)
     fig.tight_layout()
 
     def update(k):
-        changed = [clock]
-        for paths, circles in panels:
-            for i, c in enumerate(circles):
-                c.set_center(tuple(paths[k, i]))
-            changed.extend(circles)
+        for paths, discs, quiver, speeds in panels:
+            here = paths[k]
+            gone = ~np.isfinite(here).all(axis=1)  # not there at this time (added later, or removed)
+            discs.set_offsets(np.where(gone[:, None], 1e9, here))
+            if quiver is not None:
+                quiver.set_offsets(np.where(gone[:, None], 1e9, here))
+                quiver.set_UVC(*np.nan_to_num(speeds[k]).T)
         for t, patch in outlines:
             patch.set_visible(t <= times[k])
         frame = (times[k] - times[0]) / dt if dt > 0 else math.nan
         on_frame = dt > 0 and abs(frame - round(frame)) < 1e-9
         clock.set_text(f"t = {times[k]:.3f}" + (f"  (PIT frame {round(frame)})" if on_frame else ""))
-        return changed
+        return dynamic
 
     update(0)
     anim = animation.FuncAnimation(fig, update, frames=len(times), interval=1000.0 / fps, blit=False)
     if path is not None:
-        # matplotlib's stubs ask for an int, but both writers take any positive frame rate (1000 / fps ms a frame).
-        gif = path.suffix.lower() == ".gif"
-        writer = animation.PillowWriter(fps=fps) if gif else animation.FFMpegWriter(fps=fps)  # type: ignore[arg-type]
         path.parent.mkdir(parents=True, exist_ok=True)
-        anim.save(str(path), writer=writer, dpi=dpi)
+        if path.suffix.lower() == ".gif":
+            _save_gif(fig, update, dynamic, len(times), path, fps, dpi)
+            anim._draw_was_started = True  # type: ignore[attr-defined]  # saved without FuncAnimation's loop
+        else:
+            # matplotlib's stubs ask for an int, but the writer takes any positive frame rate.
+            anim.save(str(path), writer=animation.FFMpegWriter(fps=fps), dpi=dpi)  # type: ignore[arg-type]
     return anim
+
+
+def _save_gif(fig, update, dynamic, count: int, path: Path, fps: float, dpi: int) -> None:
+    """Write the animation as a GIF by blitting: the still parts (axes, ticks, box, titles) are drawn once,
+    and each frame redraws only the moving artists onto a copy of them (Pillow writes the file)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    fig.set_dpi(dpi)
+    canvas = FigureCanvasAgg(fig)
+    for artist in dynamic:
+        artist.set_animated(True)
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    images: list[Any] = []
+    for k in range(count):
+        update(k)
+        canvas.restore_region(background)
+        for artist in dynamic:
+            fig.draw_artist(artist)
+        rgb = np.asarray(canvas.buffer_rgba())[..., :3]
+        image = Image.fromarray(np.ascontiguousarray(rgb))
+        # One palette for the whole movie (the first frame's): quantising each frame alone costs more.
+        images.append(image.quantize(256) if not images else image.quantize(palette=images[0]))
+    for artist in dynamic:
+        artist.set_animated(False)
+    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000.0 / fps), loop=0)
 
 
 def _figure_of(obj: Any) -> Figure:

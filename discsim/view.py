@@ -26,7 +26,7 @@ import base64
 import html
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -34,7 +34,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import ADD, COLLISION, EVENT_DTYPE, REMOVE
+from discsim.events import ADD, COLLISION, EVENT_DTYPE
+from discsim.trajectory import LastRecords
 
 if TYPE_CHECKING:
     from discsim.model import Box
@@ -54,31 +55,29 @@ _ASSETS = Path(__file__).parent / "_assets"
 
 @dataclass(frozen=True)
 class _Run:
-    """One run reduced to what the page needs: the scene, the span and the log."""
+    """One run reduced to what the page needs: the scene, where its log starts, and its records chunk by chunk.
+
+    ``chunks()`` walks the log from its start (a streamed log is read from disk chunk by chunk), so that
+    a span late in a long log is replayed with memory flat in the log's length.
+    """
 
     label: str
     engine: str
-    radii: np.ndarray
-    masses: np.ndarray
-    groups: np.ndarray
     box: Box
     segments: tuple
-    positions0: np.ndarray
-    velocities0: np.ndarray
+    origin: LastRecords
     start_time: float
     end_time: float
-    events: np.ndarray
+    chunks: Callable[[], Iterable[np.ndarray]]
     dt: float | None
 
-    def __post_init__(self):
-        changed = np.flatnonzero((self.events["kind"] == ADD) | (self.events["kind"] == REMOVE))
-        if len(changed):
-            t = float(self.events["time"][changed[0]])
-            msg = (
-                f"cannot view {self.label!r}: the viewer replays a fixed set of discs, and this run added or removed "
-                f"discs (add_discs / remove_discs) at time {t!r}; view a run without such changes"
-            )
-            raise InvalidArgumentError(msg)
+
+@dataclass(frozen=True)
+class _Span:
+    """A run's records for the span ``[t0, t1]``: where each disc stood at ``t0`` and the events in the span."""
+
+    before: LastRecords
+    events: np.ndarray
 
 
 # --- reading the sources ---------------------------------------------------------------------------------
@@ -89,51 +88,64 @@ def _from_engine(sim, label: str | None) -> _Run:
     context = getattr(sim, "run_context", None)
     stream = None if context is None else context.stream
     if stream is not None:  # the run streamed its log to disk: replay the file, with the engine's scene
-        from discsim.io.streams import read_events
-
-        log = read_events(stream["path"], partial=True)
-        return _from_stream(log, label or name, name, getattr(sim, "segments", ()), getattr(sim, "dt", None))
+        return _from_log_file(
+            Path(stream["path"]), label or name, name, getattr(sim, "segments", ()), getattr(sim, "dt", None)
+        )
     if not getattr(sim, "record", True):
         msg = (
             f"cannot view this {name}: it was built with record=False, so it recorded no event log to replay; "
             "build it with record=True, or stream its log with run(record_to=PATH) and view PATH"
         )
         raise InvalidArgumentError(msg)
-    events = sim.events  # names the file when the log was streamed to disk
-    discs = sim.discs
+    events = sim.events
+    if events.dtype != EVENT_DTYPE:
+        msg = f"cannot view {label or name!r}: its log is not of the event dtype ({events.dtype})"
+        raise InvalidArgumentError(msg)
+    discs, ids = sim.run_context.log_origin(sim.discs) if context is not None else (sim.discs, None)
     dt = getattr(sim, "dt", None)
     return _Run(
         label=label or name,
         engine=name,
-        radii=discs.radii,
-        masses=discs.masses,
-        groups=discs.groups,
         box=sim.box,
         segments=tuple(getattr(sim, "segments", ())),
-        positions0=discs.positions,
-        velocities0=discs.velocities,
+        origin=LastRecords.at_start(discs, float(sim.start_time), ids),
         start_time=float(sim.start_time),
         end_time=float(sim.time),
-        events=events,
+        chunks=lambda: iter([events]),
         dt=float(dt) if dt else None,
     )
 
 
 def _from_stream(log, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
-    d = log.discs
+    """A run from the :class:`~discsim.io.streams.StreamedEvents` of :func:`discsim.read_events` (in memory)."""
+    events = log.events
     return _Run(
         label=label,
         engine=engine,
-        radii=d.radii,
-        masses=d.masses,
-        groups=d.groups,
         box=log.box,
         segments=tuple(segments),
-        positions0=d.positions,
-        velocities0=d.velocities,
+        origin=LastRecords.at_start(log.discs, float(log.start_time), log.ids),
         start_time=float(log.start_time),
         end_time=float(log.end_time),
-        events=log.events,
+        chunks=lambda: iter([events]),
+        dt=dt,
+    )
+
+
+def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
+    """A run from a streamed log on disk, read chunk by chunk when the page is made (never whole)."""
+    from discsim.io.streams import iter_events
+
+    log = iter_events(path, partial=True)
+    return _Run(
+        label=label,
+        engine=engine,
+        box=log.box,
+        segments=tuple(segments),
+        origin=LastRecords.at_start(log.discs, log.start_time, log.ids),
+        start_time=log.start_time,
+        end_time=log.end_time,
+        chunks=log.record_arrays,
         dt=dt,
     )
 
@@ -153,7 +165,6 @@ def _checkpoint_scene(path: Path):
 def _from_path(path: Path, label: str | None) -> _Run:
     from discsim.io.checkpoints import load
     from discsim.io.container import STATE_MAGIC
-    from discsim.io.streams import read_events
 
     if not path.exists():
         msg = f"cannot view {str(path)!r}: no such file or folder"
@@ -168,13 +179,12 @@ def _from_path(path: Path, label: str | None) -> _Run:
                 f"checkpoint ({RUN_FOLDER_FILES[1]}); a run folder is written by `discsim run --out FOLDER`"
             )
             raise InvalidArgumentError(msg)
-        log = read_events(events_file, partial=True)
         engine, segments, dt = _checkpoint_scene(checkpoint) if checkpoint.exists() else ("EventDriven", (), None)
-        return _from_stream(log, label or path.name, engine, segments, dt)
+        return _from_log_file(events_file, label or path.name, engine, segments, dt)
     with path.open("rb") as handle:
         is_state = handle.read(len(STATE_MAGIC)) == STATE_MAGIC
     if not is_state:  # an event log (read_events names what else it may be)
-        return _from_stream(read_events(path, partial=True), label or path.name)
+        return _from_log_file(path, label or path.name)
     sim = load(path)  # a checkpoint: its log is in it, or was streamed to a file it names
     stream = sim.run_context.stream
     if stream is not None:
@@ -182,7 +192,7 @@ def _from_path(path: Path, label: str | None) -> _Run:
         if not log_path.is_absolute() and not log_path.exists():
             log_path = path.parent / log_path.name
         _, segments, dt = _checkpoint_scene(path)
-        return _from_stream(read_events(log_path, partial=True), label or path.name, type(sim).__name__, segments, dt)
+        return _from_log_file(log_path, label or path.name, type(sim).__name__, segments, dt)
     return _from_engine(sim, label or path.name)
 
 
@@ -212,26 +222,58 @@ def _b64(array: np.ndarray, dtype: str) -> str:
     return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
 
 
-def _records(run: _Run, t0: float, t1: float):
-    """Each disc's state records within ``[t0, t1]``, as :func:`discsim.trajectory.reconstruct` orders them.
+def _read_span(run: _Run, t0: float, t1: float, limit: int) -> tuple[_Span, bool]:
+    """Where each disc stood at ``t0`` and the events in ``[t0, t1]``, reading the log chunk by chunk.
 
-    Returns ``(starts (N + 1,), times (R,), states (R, 4), partners (R,))``: disc ``d`` owns records
-    ``starts[d]:starts[d + 1]``, sorted by time then log order; a record holds ``x, y, vx, vy`` after the
-    event at ``times``; ``partners`` is -2 for the state where the log starts, -1 for a wall hit, else the
-    other disc. A disc keeps its last record at or before ``t0`` (which may be the initial state), so that
-    positions in ``[t0, t1]`` come from the same records, and the same arithmetic, as ``trajectory()``.
+    Records before ``t0`` only move each disc's last record on (:meth:`LastRecords.after`); reading stops at
+    the first chunk past ``t1``, or once more than ``limit`` events are held (then the second value is True).
     """
-    n = len(run.radii)
-    events = run.events[run.events["time"] <= t1]
+    before, held, count = run.origin, [], 0
+    for records in run.chunks():
+        if not len(records):
+            continue
+        times = records["time"]
+        if times.min() > t1:
+            break
+        if times.max() < t0:  # wholly before the span: only where it leaves each disc
+            before = before.after(records)
+            continue
+        early = times < t0
+        if early.any():
+            before = before.after(records[early])
+        inside = records[~early & (times <= t1)]
+        if len(inside):
+            held.append(inside)
+            count += len(inside)
+            if count > limit:
+                return _Span(before, np.concatenate(held)), True
+    events = np.concatenate(held) if held else np.zeros(0, dtype=EVENT_DTYPE)
+    return _Span(before, events), False
+
+
+def _records(span: _Span, t0: float):
+    """Each disc's state records from ``t0`` on, as :func:`discsim.trajectory.reconstruct` orders them.
+
+    Returns ``(starts (M + 1,), times (R,), states (R, 4), partners (R,))``: disc id ``d`` owns records
+    ``starts[d]:starts[d + 1]``, sorted by time then log order; a record holds ``x, y, vx, vy`` after the
+    event at ``times`` (NaN while the disc is not there: before its ``ADD`` record, from its ``REMOVE``
+    record on); ``partners`` is -2 for the disc's last record before ``t0`` (or where the log starts), -1 for
+    a wall hit or a change, else the other disc. A disc keeps its last record at or before ``t0``, so that
+    positions in the span come from the same records, and the same arithmetic, as ``trajectory()``.
+    """
+    events = span.events
+    top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
+    before = span.before.grown(top)
+    n = len(before)
     pair = np.flatnonzero(events["j"] >= 0)
     ev = events[pair]
     disc = np.concatenate([np.arange(n), events["i"], ev["j"]])
-    times = np.concatenate([np.full(n, run.start_time), events["time"], ev["time"]])
+    times = np.concatenate([before.times, events["time"], ev["time"]])
     seq = np.concatenate([np.full(n, -1), np.arange(len(events)), pair])
     partner = np.concatenate([np.full(n, -2), events["j"], ev["i"]])
     states = np.vstack(
         [
-            np.hstack([run.positions0, run.velocities0]),
+            np.hstack([before.positions, before.velocities]),
             np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]),
             np.column_stack([ev["xj"], ev["yj"], ev["vxj"], ev["vyj"]]),
         ]
@@ -245,6 +287,13 @@ def _records(run: _Run, t0: float, t1: float):
     disc, times, partner, states = disc[keep], times[keep], partner[keep], states[keep]
     starts = np.searchsorted(disc, np.arange(n + 1))
     return starts, times, states, partner
+
+
+def _discs_of(span: _Span) -> LastRecords:
+    """Every disc id the span shows, with radii, masses and groups (those added in the span included)."""
+    events = span.events
+    top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
+    return span.before.after(events[events["kind"] == ADD]).grown(top) if len(events) else span.before
 
 
 def _span(runs: list[_Run], start, until) -> tuple[float, float]:
@@ -262,23 +311,25 @@ def _span(runs: list[_Run], start, until) -> tuple[float, float]:
     return t0, t1
 
 
-def _run_data(run: _Run, t0: float, t1: float, truth: bool) -> dict:
-    starts, times, states, partners = _records(run, t0, t1)
+def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict:
+    starts, times, states, partners = _records(span, t0)
+    discs = _discs_of(span)
     box = run.box
-    ev = run.events
+    ev = span.events
     contacts = ev[(ev["kind"] == COLLISION) & (ev["time"] >= t0) & (ev["time"] <= t1)]
     speeds = np.hypot(states[:, 2], states[:, 3])
+    speeds = speeds[np.isfinite(speeds)]
     return {
         "label": run.label,
         "engine": run.engine,
         "dt": run.dt,
         "truth": truth,
-        "n": len(run.radii),
+        "n": len(discs),
         "box": {"width": float(box.width), "height": float(box.height), "periodic": bool(box.periodic)},
         "segments": [[*map(float, s.p0), *map(float, s.p1)] for s in run.segments],
-        "radii": _b64(run.radii, "<f8"),
-        "fixed": _b64(np.isinf(run.masses), "u1"),
-        "groups": _b64(run.groups, "<i4"),
+        "radii": _b64(np.nan_to_num(discs.radii), "<f8"),
+        "fixed": _b64(np.isinf(discs.masses), "u1"),
+        "groups": _b64(discs.groups, "<i4"),
         "starts": _b64(starts, "<i4"),
         "times": _b64(times, "<f8"),
         "states": _b64(states, "<f8"),
@@ -290,14 +341,11 @@ def _run_data(run: _Run, t0: float, t1: float, truth: bool) -> dict:
 
 
 def _check_nonempty(run: _Run) -> None:
-    if run.end_time <= run.start_time and not len(run.events):
+    if run.end_time <= run.start_time and not any(len(c) for c in run.chunks()):
         msg = (
             f"cannot view {run.label!r}: it recorded nothing (no event, and no time elapsed: "
             f"t = {run.start_time!r}); run it first, e.g. sim.run(until=...)"
         )
-        raise InvalidArgumentError(msg)
-    if run.events.dtype != EVENT_DTYPE:
-        msg = f"cannot view {run.label!r}: its log is not of the event dtype ({run.events.dtype})"
         raise InvalidArgumentError(msg)
 
 
@@ -331,11 +379,16 @@ class View:
         html: the whole page, one self-contained HTML document (str).
         path: the file written, or None.
         span: ``(t0, t1)``, the simulated times the page replays.
-        events: the number of events it holds (all runs together).
+        events: the number of events it holds (all runs together), those in ``span``.
+        note: None, or what the page shows instead of what was asked (the first ``max_events`` events when
+            no ``until`` was given and the run holds more).
     """
 
-    def __init__(self, html_text: str, path: Path | None, span: tuple[float, float], events: int, height: int):
+    def __init__(
+        self, html_text: str, path: Path | None, span: tuple[float, float], events: int, height: int, note=None
+    ):
         self.html = html_text
+        self.note = note
         self.path = path
         self.span = span
         self.events = events
@@ -374,6 +427,7 @@ def view(
     contact_window: float | None = None,
     max_events: int = DEFAULT_MAX_EVENTS,
     title: str | None = None,
+    arrows: bool = False,
 ) -> View:
     """Write a self-contained HTML page that replays runs exactly, from their event logs.
 
@@ -394,13 +448,20 @@ def view(
         speed: playback speed in simulated time per second of real time; default the span over 10 s
             (at least one frame interval of a PIT run per 0.25 s). The page can change it.
         fps: frames drawn per second of real time while playing.
-        start, until: the span of simulated time to replay (default all that every run covers).
+        start, until: the span of simulated time to replay (default all that every run covers). Only the
+            events in the span count and are held: a streamed log is read chunk by chunk, from its start
+            to ``until``, keeping each disc's last record before ``start`` (memory flat in the log's length).
+            With no ``until`` and more than ``max_events`` events from ``start`` on, the page shows the
+            first ``max_events`` of them and says so (:attr:`View.note`).
         contact_window: exact contacts (collisions of the event-driven runs) are drawn as outlines from
             their time on, for this long in simulated time; default: for ever when the runs hold at most
             60 contacts, else 2% of the span.
-        max_events: refuse to write a page holding more events than this (about 140 bytes each): ask
-            for a shorter span with ``start``/``until``.
+        max_events: at most this many events in the page (about 140 bytes each): a span that holds more,
+            with ``until`` given, is refused (ask for a shorter one).
         title: the page's title.
+        arrows: start with velocity arrows drawn (an arrow is where the disc gets in the time the fastest
+            1% take to fly four radii of the largest disc). The page can switch them, and zoom (mouse wheel,
+            drag, double-click for the whole box).
 
     Returns:
         A :class:`View` (``html``, ``path``, ``span``, ``events``; shows itself inline in Jupyter).
@@ -408,7 +469,8 @@ def view(
     Raises:
         InvalidArgumentError: before anything is written, for a run that recorded nothing (``record=False``,
             or no time elapsed), a folder or file with no event log, a span outside the runs, a bad
-            ``colour``, ``speed``, ``fps``, ``labels`` or ``max_events``, or more events than ``max_events``.
+            ``colour``, ``speed``, ``fps``, ``labels`` or ``max_events``, or more events than ``max_events``
+            between ``start`` and a given ``until``.
         CheckpointError: for a damaged event log or checkpoint.
 
     Example:
@@ -445,28 +507,45 @@ def view(
         _check_nonempty(r)
     panel_labels = _panel_labels(runs, labels)
     t0, t1 = _span(runs, start, until)
-    held = sum(int((r.events["time"] <= t1).sum()) for r in runs)
+    spans = [_read_span(r, t0, t1, max_events)[0] for r in runs]
+    held = sum(len(s.events) for s in spans)
+    note = None
     if held > max_events:
-        msg = (
-            f"the replay would hold {held:,} events, more than max_events={max_events:,} (about 140 bytes "
-            "each); choose a shorter span with start= and until= (--start/--until), or raise max_events"
+        if until is not None:
+            msg = (
+                f"the replay would hold more than max_events={max_events:,} events in [{t0!r}, {t1!r}] (about 140 "
+                "bytes each); choose a shorter span with start= and until= (--start/--until), or raise max_events"
+            )
+            raise InvalidArgumentError(msg)
+        # No end asked for: show the first max_events events from t0 on (every run holds all those it has).
+        times = np.sort(np.concatenate([s.events["time"] for s in spans]))
+        below = times[times < times[max_events]]
+        if not len(below):
+            msg = f"more than max_events={max_events:,} events happen at t = {times[0]!r}; raise max_events"
+            raise InvalidArgumentError(msg)
+        t1 = float(below[-1])
+        spans = [_Span(s.before, s.events[s.events["time"] <= t1]) for s in spans]
+        held = sum(len(s.events) for s in spans)
+        note = (
+            f"more than max_events={max_events:,} events after t = {t0:g}: showing the first {held:,}, "
+            f"t in [{t0:g}, {t1:g}]; choose the span with start= and until= (--start/--until) or raise max_events"
         )
-        raise InvalidArgumentError(msg)
     has_truth = any(r.engine == "EventDriven" for r in runs)
     data_runs = []
-    for r, label in zip(runs, panel_labels, strict=True):
-        d = _run_data(r, t0, t1, truth=r.engine == "EventDriven" or not has_truth)
+    for r, sp, label in zip(runs, spans, panel_labels, strict=True):
+        d = _run_data(r, sp, t0, t1, truth=r.engine == "EventDriven" or not has_truth)
         d["label"] = label
         data_runs.append(d)
     if colour == "auto":
-        n, groups = len(runs[0].radii), runs[0].groups
+        first = _discs_of(spans[0])
+        n, groups = int(np.isfinite(first.radii).sum()), first.groups[np.isfinite(first.radii)]
         colour = "disc" if n <= 20 else ("group" if len(np.unique(groups)) > 1 else "speed")
     if speed is None:
         speed = (t1 - t0) / 10.0 if t1 > t0 else 1.0
         frame = max((r.dt or 0.0) for r in runs)
         speed = max(speed, 4.0 * frame) if frame else speed
         speed = min(speed, t1 - t0) if t1 > t0 else speed
-    n_contacts = max(int((r.events["kind"] == COLLISION).sum()) for r in runs)
+    n_contacts = max(int((s.events["kind"] == COLLISION).sum()) for s in spans)
     if contact_window is None:
         contact_window = math.inf if n_contacts <= 60 else 0.02 * (t1 - t0)
     data = {
@@ -476,12 +555,13 @@ def view(
         "speed": float(speed),
         "fps": float(fps),
         "colour": colour,
+        "arrows": bool(arrows),
         "contact_window": None if math.isinf(contact_window) else float(contact_window),
         "runs": data_runs,
     }
     page = _page(data)
     height = 760 if len(runs) > 1 else 700
-    result = View(page, None, (t0, t1), held, height)
+    result = View(page, None, (t0, t1), held, height, note)
     if path is not None:
         result.save(path)
     return result

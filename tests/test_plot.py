@@ -6,7 +6,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import matplotlib.collections
 import matplotlib.pyplot as plt
+import matplotlib.quiver
 import numpy as np
 import pytest
 from matplotlib import animation
@@ -54,6 +56,18 @@ def test_plot_state_of_discs_and_of_an_engine(tmp_path):
     assert plot.plot_state(sim, ax=given) is given
     assert "t = 0.5" in given.get_title()
     assert_not_blank(plot.save_figure(fig, tmp_path / "sim.png"))
+
+
+def test_plot_state_clips_velocity_arrows_at_the_box():
+    # A fast disc next to the right wall: its arrow (four radii long) would reach past the box.
+    discs = ds.Discs([[7.0, 2.0], [2.0, 2.0]], [[3.0, 0.0], [0.5, 0.0]], radii=0.8)
+    ax = plot.plot_state(discs, box=ds.Box(8.0, 4.0))
+    (quiver,) = [c for c in ax.collections if isinstance(c, matplotlib.quiver.Quiver)]
+    assert quiver.U[0] + quiver.X[0] > 8.0  # drawn to scale, it leaves the box ...
+    ax.figure.canvas.draw()
+    clip = quiver.get_clip_box()  # ... so it is cut at the walls (matplotlib keeps a rectangle as a box)
+    bounds = ax.transData.inverted().transform(clip.get_points())
+    np.testing.assert_allclose([bounds.min(axis=0), bounds.max(axis=0)], [[0.0, 0.0], [8.0, 4.0]], atol=1e-9)
 
 
 def test_plot_trajectories_draws_one_path_per_disc(tmp_path):
@@ -169,3 +183,60 @@ def test_case_figures_are_readable_zoomed_and_never_stack_labels():
     obstacle = pic.discs.positions[np.isinf(pic.discs.masses)][0]
     for ax in fig.axes:
         assert all(np.hypot(*(np.array(t.get_position()) - obstacle)) > 0.5 for t in ax.texts)
+
+
+def test_animate_draws_small_discs_large_with_the_clock_and_arrows_clear_of_them(tmp_path):
+    case = ds.scenarios.missed_collision()  # discs of radius 0.2 in a 20 x 10 box
+    pic, pit = case_runs(case)
+    path = tmp_path / "case1.gif"
+    anim = plot.animate([pit, pic], path, arrows=True, dpi=80)
+    fig = anim._fig
+    ax = fig.axes[0]
+    pixels_per_unit = np.diff(ax.transData.transform([[0.0, 0.0], [1.0, 0.0]]), axis=0)[0, 0] * 80 / fig.dpi
+    assert 2 * 0.2 * pixels_per_unit > 9  # a disc over 9 pixels wide (4.6 when the whole box was shown)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 61 and gif.size[0] == round(fig.get_figwidth() * 80)
+    (clock,) = [t for t in ax.texts if t.get_text().startswith("t = ")]
+    assert clock.get_position()[1] > 1.0  # above the panel, not over the discs
+    assert ax.get_xlabel() == "x" and ax.get_ylabel() == "y"
+    # One arrow per disc, along its velocity at the last frame.
+    for panel, sim in zip(fig.axes, (pit, pic), strict=True):
+        (quiver,) = [c for c in panel.collections if isinstance(c, matplotlib.quiver.Quiver)]
+        np.testing.assert_allclose(quiver.get_offsets(), sim.positions)
+        arrows = np.column_stack([quiver.U, quiver.V])
+        np.testing.assert_allclose(arrows / np.abs(arrows).max(), sim.velocities / np.abs(sim.velocities).max())
+        box = panel.transData.inverted().transform(quiver.get_clip_box().get_points())
+        np.testing.assert_allclose(box, [[0.0, 0.0], [case.box.width, case.box.height]], atol=1e-9)  # cut at the walls
+    plot.close(anim)
+    # The whole box, when asked.
+    whole = plot.animate(pic, zoom=False)
+    assert whole._fig.axes[0].get_xlim()[1] > case.box.width
+    plot.close(whole)
+
+
+def test_state_figures_name_their_axes():
+    ax = plot.plot_state(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], radii=0.5), box=ds.Box(4.0, 3.0))
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x", "y")
+
+
+def test_animate_follows_discs_that_come_and_go():
+    discs, box = ds.random_gas(12, 0.2, seed=4)
+    sim = ds.EventDriven(discs, box).run(until=1.0)
+    sim.remove_discs([2, 5])
+    spots = ([x, y] for x in np.linspace(1.0, box.width - 1.0, 15) for y in np.linspace(1.0, box.height - 1.0, 15))
+    spot = next(p for p in spots if (np.hypot(*(sim.positions - p).T) > sim.discs.radii + 0.6).all())
+    sim.add_discs(ds.Discs([spot], [[1.0, -0.5]], 0.5))
+    sim.run(until=2.0)
+    anim = plot.animate(sim, times=[2.0, 0.5], arrows=True)  # the figure shows the first time, 2.0
+    (collection,) = [
+        c for c in anim._fig.axes[0].collections if isinstance(c, matplotlib.collections.EllipseCollection)
+    ]
+    expected = sim.trajectory([2.0])[0]
+    offsets = np.asarray(collection.get_offsets())
+    assert len(offsets) == len(expected) == 13  # one circle per disc id, the one added included
+    shown = np.isfinite(expected).all(axis=1)
+    np.testing.assert_allclose(offsets[shown], expected[shown])
+    assert (offsets[~shown] > 1e8).all() and (~shown).sum() == 2  # the removed discs: moved out of sight
+    # Each circle has its disc's size: the added one (id 12) its radius 0.5 (get_widths: full widths).
+    np.testing.assert_allclose(collection.get_widths(), 2.0 * np.append(discs.radii, 0.5))
+    plot.close(anim)

@@ -246,7 +246,11 @@ def test_a_streamed_run_and_a_checkpoint_can_be_viewed(tmp_path):
         (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"until": 2.0}, r"\[0.0, 1.0\]"),
         (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"speed": -1.0}, "speed must be"),
         (lambda p: ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=1.0), {"labels": ["a", "b"]}, "labels must"),
-        (lambda p: ds.EventDriven(*ds.random_gas(30, 0.3)).run(until=3.0), {"max_events": 10}, "max_events=10"),
+        (
+            lambda p: ds.EventDriven(*ds.random_gas(30, 0.3)).run(until=3.0),
+            {"until": 3.0, "max_events": 10},
+            "max_events=10",
+        ),
         (lambda p: [], {}, "at least one run"),
     ],
 )
@@ -280,3 +284,103 @@ def test_only_the_front_door_and_the_command_line_import_the_viewer():
                 importers.add(path.relative_to(package).as_posix())
     assert importers == {"__init__.py", "cli/view.py"}
     assert "matplotlib" not in (package / "view.py").read_text()  # `import discsim` stays free of matplotlib
+
+
+# --- spans, long logs, discs that come and go (issue 31) ---------------------------------------------------
+
+
+def _events_in(events, t0, t1):
+    return int(((events["time"] >= t0) & (events["time"] <= t1)).sum())
+
+
+def test_a_late_span_holds_and_counts_only_its_own_events(tmp_path, monkeypatch):
+    discs, box = ds.random_gas(300, 0.5, seed=1)
+    sim = ds.EventDriven(discs, box).run(until=4.0)
+    inside = _events_in(sim.events, 3.0, 3.5)
+    assert 0 < inside < len(sim.events) // 4
+    page = ds.view(sim, None, start=3.0, until=3.5, max_events=inside, labels=["gas"])  # earlier events do not count
+    assert page.events == inside and page.note is None
+    # A streamed log is read chunk by chunk, never whole, and gives the same page.
+    streamed = ds.EventDriven(discs, box, record=False)
+    streamed.stream_chunk = 500
+    streamed.run(until=4.0, record_to=tmp_path / "events.dse")
+    from discsim.io import container, streams
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the whole log was read into memory")
+
+    monkeypatch.setattr(container, "read_stream", refuse)
+    monkeypatch.setattr(streams, "read_stream", refuse)
+    for source in (tmp_path / "events.dse", streamed):
+        again = ds.view(source, None, start=3.0, until=3.5, max_events=inside, labels=["gas"])
+        assert again.events == inside and again.html == page.html
+
+
+def test_a_plain_view_of_a_long_run_shows_its_first_events_and_says_so(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert cli.main(["run", "--n", "100", "--packing", "0.5", "--until", "3", "--out", out, "--no-progress"]) == 0
+    capsys.readouterr()
+    assert cli.main(["view", out, "--max-events", "300"]) == 0
+    said = capsys.readouterr().out
+    assert "showing the first" in said and "max_events=300" in said
+    log = ds.read_events(out / "events.dse")
+    page = ds.view(out, None, max_events=300)
+    t0, t1 = page.span
+    assert t0 == 0.0 and t1 < log.end_time and page.events == _events_in(log.events, 0.0, t1) <= 300
+    assert _events_in(log.events, 0.0, log.events["time"][page.events]) > 300  # the next event would be one too many
+    late = ds.view(out, None, start=2.0, max_events=50)
+    assert late.span[0] == 2.0 and late.events <= 50 and "after t = 2" in late.note
+
+
+def _editing_run():
+    discs, box = ds.random_gas(12, 0.2, seed=4)
+    sim = ds.EventDriven(discs, box).run(until=1.0)
+    sim.remove_discs([2, 5])
+    spot = next(
+        p
+        for p in ([x, y] for x in np.linspace(1.0, box.width - 1.0, 15) for y in np.linspace(1.0, box.height - 1.0, 15))
+        if (np.hypot(*(sim.positions - p).T) > sim.discs.radii + 0.6).all()
+    )
+    sim.add_discs(ds.Discs([spot], [[1.0, -0.5]], 0.5))
+    sim.run(until=2.0)
+    sim.remove_discs([0])
+    sim.run(until=3.0)
+    return sim
+
+
+def test_a_run_whose_discs_come_and_go_is_drawn_where_trajectory_puts_them(tmp_path):
+    sim = _editing_run()
+    page = ds.view(sim, tmp_path / "edit.html", start=0.5)
+    times = [0.5, 0.99, 1.0, 1.5, 2.0, 2.5, 3.0]
+    readout = seek_all(page.path, tmp_path, times)
+    expected = sim.trajectory(times)
+    assert expected.shape[1] == 13 and np.isnan(expected[0, 12]).all() and np.isnan(expected[-1, [0, 2, 5]]).all()
+    for k, r in enumerate(readout):
+        (drawn,) = r["positions"]
+        drawn = np.array([[np.nan, np.nan] if p[0] is None else p for p in drawn], dtype=float)
+        np.testing.assert_array_equal(np.isnan(drawn), np.isnan(expected[k]))
+        assert_same_positions(np.nan_to_num(drawn), np.nan_to_num(expected[k]))
+
+
+def test_the_time_box_follows_playback_and_the_clock_sits_above_the_discs(tmp_path):
+    case = ds.scenarios.missed_collision()
+    pic, pit = case_runs(case)
+    page = ds.view(pic, tmp_path / "missed.html", compare_with=pit, arrows=True)
+    script = """
+discsim.setSpeed(0.2);
+discsim.play();
+setTimeout(() => {
+  discsim.pause();
+  const box = Array.from(document.querySelectorAll("#ds-controls input[type=number]"))[0];
+  const clocks = Array.from(document.querySelectorAll(".ds-clock")).map((c) => c.textContent);
+  const zoom = discsim.setZoom(4, 1.0, 1.0);
+  const zoomed = document.querySelector(".ds-clock").textContent;
+  document.getElementById("ds-readout").textContent = JSON.stringify({
+    time: discsim.time(), box: Number(box.value), clocks, zoom, zoomed, unzoomed: discsim.setZoom(1),
+  });
+}, 1000);
+"""
+    out = drive(page.path, tmp_path, script, budget_ms=3000)
+    assert out["time"] > 0.05 and out["box"] == pytest.approx(out["time"], rel=1e-9)
+    assert out["clocks"] == [f"t = {out['time']:.4f}"] * 2
+    assert out["zoom"] == 4 and "zoom 4x" in out["zoomed"] and out["unzoomed"] == 1

@@ -3,7 +3,8 @@
 // Each disc has a list of state records (time, x, y, vx, vy): where the replay starts, then after each of its
 // events. Between records a disc flies straight, so its position at time t is that of its last record at or
 // before t plus velocity times the time since, wrapped into a periodic box: the same operations, in the same
-// order, as discsim.trajectory.reconstruct, so the page draws the numbers trajectory() gives.
+// order, as discsim.trajectory.reconstruct, so the page draws the numbers trajectory() gives. A disc whose
+// state is NaN (before its ADD record, from its REMOVE record on: add_discs / remove_discs) is not drawn.
 "use strict";
 (function () {
   const DATA = JSON.parse(document.getElementById("ds-data").textContent);
@@ -112,7 +113,15 @@
   const state = {
     t: T0, playing: false, speed: DATA.speed, fps: DATA.fps, colour: DATA.colour,
     contacts: true, numbers: runs[0].n <= 20, loop: false, timer: null, wallStart: 0, tStart: T0,
+    arrows: !!DATA.arrows, zoom: 1, focus: [runs[0].box.width / 2, runs[0].box.height / 2],
   };
+  // Velocity arrows: an arrow is where the disc gets in this time (the fastest 1% reach about four radii).
+  const arrowTime = (() => {
+    let r = 0;
+    for (const run of runs) for (let d = 0; d < run.n; d++) if (run.radii[d] > r) r = run.radii[d];
+    const v = Math.max(...runs.map((run) => run.maxSpeed));
+    return v > 0 ? (4 * r) / v : 0;
+  })();
 
   function colourOf(run, d) {
     if (run.fixed[d]) return OBSTACLE;
@@ -137,11 +146,14 @@
     const div = document.createElement("div");
     div.className = "ds-panel";
     const h2 = document.createElement("h2");
-    h2.textContent = run.label;
+    h2.textContent = run.label + " ";
+    const clock = document.createElement("span");  // the time, above the box: never over the discs
+    clock.className = "ds-clock";
+    h2.append(clock);
     const canvas = document.createElement("canvas");
     div.append(h2, canvas);
     panelsEl.append(div);
-    return { run, canvas, ctx: canvas.getContext("2d"), scale: 1, pad: 0, cssWidth: 0, cssHeight: 0 };
+    return { run, canvas, clock, ctx: canvas.getContext("2d"), scale: 1, pad: 0, cssWidth: 0, cssHeight: 0 };
   });
 
   function layout() {
@@ -165,17 +177,20 @@
   function draw(p, t) {
     const { run, ctx, scale } = p;
     const box = run.box, pad = p.pad;
-    const ox = (p.cssWidth - (box.width + 2 * pad) * scale) / 2;
-    const X = (x) => ox + (x + pad) * scale;
-    const Y = (y) => p.cssHeight - (y + pad) * scale;
+    // Zoom about state.focus (a point of the box, drawn at the canvas's centre): 1 shows the whole box.
+    const z = scale * state.zoom, [fx, fy] = state.focus;
+    const X = (x) => p.cssWidth / 2 + (x - fx) * z;
+    const Y = (y) => p.cssHeight / 2 - (y - fy) * z;
+    void pad;
     ctx.clearRect(0, 0, p.cssWidth, p.cssHeight);
     ctx.save();
     ctx.beginPath();
-    ctx.rect(X(0), Y(box.height), box.width * scale, box.height * scale);
+    ctx.rect(X(0), Y(box.height), box.width * z, box.height * z);
     if (box.periodic) ctx.clip();  // discs crossing a periodic edge show on both sides
     const shifts = box.periodic ? [-1, 0, 1] : [0];
     for (let d = 0; d < run.n; d++) {
       const r = run.radii[d];
+      if (!Number.isFinite(run.x[d])) continue;  // not there at t (added later, or removed)
       ctx.fillStyle = colourOf(run, d);
       ctx.globalAlpha = 0.8;
       for (const sx of shifts) {
@@ -183,7 +198,7 @@
           const x = run.x[d] + sx * box.width, y = run.y[d] + sy * box.height;
           if (x + r < 0 || x - r > box.width || y + r < 0 || y - r > box.height) continue;
           ctx.beginPath();
-          ctx.arc(X(x), Y(y), Math.max(0.5, r * scale), 0, 2 * Math.PI);
+          ctx.arc(X(x), Y(y), Math.max(0.5, r * z), 0, 2 * Math.PI);
           ctx.fill();
         }
       }
@@ -198,17 +213,41 @@
         if (window_ !== null && c.t < t - window_) continue;
         ctx.strokeStyle = contactColour(c);
         ctx.beginPath();
-        ctx.arc(X(c.x), Y(c.y), Math.max(0.5, c.r * scale), 0, 2 * Math.PI);
+        ctx.arc(X(c.x), Y(c.y), Math.max(0.5, c.r * z), 0, 2 * Math.PI);
         ctx.stroke();
       }
       ctx.setLineDash([]);
+    }
+    if (state.arrows && arrowTime > 0) {
+      ctx.strokeStyle = "#111";
+      ctx.fillStyle = "#111";
+      ctx.lineWidth = 1.2;
+      const s = run.states;
+      for (let d = 0; d < run.n; d++) {
+        const k = run.rec[d], x = run.x[d], y = run.y[d];
+        if (!Number.isFinite(x) || run.fixed[d]) continue;
+        const ex = X(x + s[4 * k + 2] * arrowTime), ey = Y(y + s[4 * k + 3] * arrowTime);
+        const bx = X(x), by = Y(y), len = Math.hypot(ex - bx, ey - by);
+        if (len < 1) continue;
+        const head = Math.min(6, 0.4 * len), ux = (ex - bx) / len, uy = (ey - by) / len;
+        ctx.beginPath();
+        ctx.moveTo(bx, by);
+        ctx.lineTo(ex, ey);
+        ctx.stroke();
+        ctx.beginPath();
+        ctx.moveTo(ex, ey);
+        ctx.lineTo(ex - head * (ux + 0.5 * uy), ey - head * (uy - 0.5 * ux));
+        ctx.lineTo(ex - head * (ux - 0.5 * uy), ey - head * (uy + 0.5 * ux));
+        ctx.fill();
+      }
     }
     if (state.numbers && run.n <= 50) {
       ctx.fillStyle = "#111";
       ctx.textAlign = "center";
       ctx.textBaseline = "middle";
       for (let d = 0; d < run.n; d++) {
-        const size = Math.max(9, Math.min(14, run.radii[d] * scale * 0.9));
+        if (!Number.isFinite(run.x[d])) continue;
+        const size = Math.max(9, Math.min(14, run.radii[d] * z * 0.9));
         ctx.font = `${size}px sans-serif`;
         ctx.fillText(String(d), X(run.x[d]), Y(run.y[d]));
       }
@@ -217,7 +256,7 @@
     ctx.strokeStyle = "#333";
     ctx.lineWidth = 1.2;
     ctx.setLineDash(box.periodic ? [2, 3] : []);
-    ctx.strokeRect(X(0), Y(box.height), box.width * scale, box.height * scale);
+    ctx.strokeRect(X(0), Y(box.height), box.width * z, box.height * z);
     ctx.setLineDash([]);
     ctx.lineWidth = 2;
     for (const s of run.segments) {
@@ -226,13 +265,7 @@
       ctx.lineTo(X(s[2]), Y(s[3]));
       ctx.stroke();
     }
-    ctx.fillStyle = "rgba(255,255,255,0.8)";
-    ctx.fillRect(X(0) + 2, Y(box.height) + 2, 92, 17);
-    ctx.fillStyle = "#111";
-    ctx.font = "12px sans-serif";
-    ctx.textAlign = "left";
-    ctx.textBaseline = "top";
-    ctx.fillText(`t = ${t.toFixed(4)}`, X(0) + 5, Y(box.height) + 4);
+    p.clock.textContent = `t = ${t.toFixed(4)}` + (state.zoom !== 1 ? `, zoom ${+state.zoom.toPrecision(3)}x` : "");
   }
 
   // --- controls ------------------------------------------------------------------------------------------------
@@ -274,6 +307,8 @@
   contactsBox.onchange = () => { state.contacts = contactsBox.checked; render(); };
   const numbersBox = labelled("numbers", el("input", { type: "checkbox", checked: state.numbers }));
   numbersBox.onchange = () => { state.numbers = numbersBox.checked; render(); };
+  const arrowsBox = labelled("arrows", el("input", { type: "checkbox", checked: state.arrows }));
+  arrowsBox.onchange = () => { state.arrows = arrowsBox.checked; render(); };
   const loopBox = labelled("loop", el("input", { type: "checkbox", checked: state.loop }));
   loopBox.onchange = () => { state.loop = loopBox.checked; };
 
@@ -281,7 +316,8 @@
     `${runs[0].n} discs, ${runs[0].box.periodic ? "periodic box" : "box with walls"} ` +
     `${+runs[0].box.width.toPrecision(6)} x ${+runs[0].box.height.toPrecision(6)}; t from ${T0} to ${T1}; ` +
     `${eventTimes.length} event times; ${contacts.length / 2} exact contacts (outlined). ` +
-    "Keys: Space play/pause, Left/Right one frame, Shift+Left/Right one event.";
+    "Keys: Space play/pause, Left/Right one frame, Shift+Left/Right one event. " +
+    "Zoom: the mouse wheel (or + and -), drag to move, double-click (or 0) for the whole box.";
 
   // --- the player ----------------------------------------------------------------------------------------------
   function render() {
@@ -291,6 +327,7 @@
       draw(p, state.t);
     }
     timeEl.textContent = `t = ${state.t.toPrecision(8)} of [${T0}, ${T1}]`;
+    if (document.activeElement !== timeInput) timeInput.value = +state.t.toPrecision(10);  // follows playback
     if (document.activeElement !== scrub) scrub.value = T1 > T0 ? Math.round(((state.t - T0) / (T1 - T0)) * SCRUB) : 0;
     colourSelect.value = state.colour;
     scaleEl.style.display = state.colour === "speed" ? "inline-block" : "none";
@@ -373,6 +410,48 @@
     return f;
   }
 
+  // Zoom by `factor` (1: the whole box) about the box point (x, y), drawn at the centre; default the focus.
+  function setZoom(factor, x = state.focus[0], y = state.focus[1]) {
+    if (!(factor > 0) || !Number.isFinite(factor)) return state.zoom;
+    state.zoom = Math.min(1000, Math.max(1, factor));
+    const box = runs[0].box;
+    state.focus = state.zoom === 1 ? [box.width / 2, box.height / 2] : [x, y];
+    render();
+    return state.zoom;
+  }
+
+  function setArrows(on) {
+    state.arrows = !!on;
+    arrowsBox.checked = state.arrows;
+    render();
+    return state.arrows;
+  }
+
+  // The box point under a mouse event on a panel's canvas.
+  function boxPoint(p, e) {
+    const rect = p.canvas.getBoundingClientRect(), z = p.scale * state.zoom;
+    return [state.focus[0] + (e.clientX - rect.left - p.cssWidth / 2) / z,
+            state.focus[1] - (e.clientY - rect.top - p.cssHeight / 2) / z];
+  }
+  for (const p of panels) {
+    p.canvas.addEventListener("wheel", (e) => {
+      e.preventDefault();
+      const [x, y] = boxPoint(p, e), old = state.zoom, factor = Math.min(1000, Math.max(1, old * (e.deltaY < 0 ? 1.25 : 0.8)));
+      const keep = old / factor;  // the point under the mouse stays there
+      setZoom(factor, x + (state.focus[0] - x) * keep, y + (state.focus[1] - y) * keep);
+    }, { passive: false });
+    let drag = null;
+    p.canvas.addEventListener("mousedown", (e) => { drag = [e.clientX, e.clientY, ...state.focus]; });
+    window.addEventListener("mouseup", () => { drag = null; });
+    window.addEventListener("mousemove", (e) => {
+      if (!drag || state.zoom === 1) return;
+      const z = p.scale * state.zoom;
+      state.focus = [drag[2] - (e.clientX - drag[0]) / z, drag[3] + (e.clientY - drag[1]) / z];
+      render();
+    });
+    p.canvas.addEventListener("dblclick", () => setZoom(1));
+  }
+
   function setColour(mode) {
     if (["disc", "group", "speed"].includes(mode)) state.colour = mode;
     render();
@@ -400,12 +479,15 @@
     else if (e.key === "ArrowLeft") { if (e.shiftKey) previousEvent(); else step(-1); e.preventDefault(); }
     else if (e.key === "Home") seek(T0);
     else if (e.key === "End") seek(T1);
+    else if (e.key === "+" || e.key === "=") setZoom(state.zoom * 1.25);
+    else if (e.key === "-") setZoom(state.zoom * 0.8);
+    else if (e.key === "0") setZoom(1);
   });
   window.addEventListener("resize", () => { layout(); render(); });
 
   window.discsim = {
     seek, time: () => state.t, positions, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
-    setColour, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
+    setColour, setZoom, setArrows, zoom: () => state.zoom, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
     labels: runs.map((r) => r.label), eventTimes: () => eventTimes.slice(),
   };
 

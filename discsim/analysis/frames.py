@@ -17,7 +17,7 @@ import numpy as np
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, REMOVE
 from discsim.model import Box, Discs
-from discsim.trajectory import check_times, reconstruct
+from discsim.trajectory import LastRecords, check_times, reconstruct, replay
 
 __all__ = ["Frames", "frames", "log_source", "states_at"]
 
@@ -175,10 +175,11 @@ def _changed_message(what: str, time: float | None) -> str:
 
 def _log_source(source, what: str):
     from discsim.io.container import iter_stream
-    from discsim.io.streams import StreamedEvents, read_events
+    from discsim.io.streams import StreamedEvents, iter_events
 
-    if isinstance(source, (str, Path)):
-        source = read_events(source)
+    if isinstance(source, (str, Path)):  # read chunk by chunk, never whole
+        chunked = iter_events(source)
+        return chunked.record_arrays, chunked.discs, chunked.box, chunked.start_time, chunked.end_time, None
     if isinstance(source, StreamedEvents):
         log = source
         return (lambda: iter([log.events])), log.discs, log.box, log.start_time, log.end_time, None
@@ -236,9 +237,9 @@ def frames(source, times) -> Frames:
     """
     chunks, discs, box, start, end, _ = log_source(source, "frames()")
     times = check_times(times, start, end, "simulated span")
-    parts = list(chunks())
-    events = np.concatenate(parts) if len(parts) > 1 else parts[0]
-    unwrapped, velocities = states_at(events, discs.positions, discs.velocities, start, times, box)
+    # A streamed log is read one chunk at a time, up to the last time asked: memory flat in its length.
+    origin = LastRecords.at_start(discs, start)
+    unwrapped, velocities = replay(chunks(), origin, times, box, unwrapped=True, velocities=True)
     return Frames(
         times,
         box.wrap(unwrapped),

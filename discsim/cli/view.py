@@ -31,8 +31,14 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
         help=f"the page to write (default: {DEFAULT_VIEW_FILE} in the run folder, or beside the file)",
     )
     parser.add_argument("--start", type=float, default=None, help="first simulated time shown (default: the start)")
-    parser.add_argument("--until", type=float, default=None, help="last simulated time shown (default: the end)")
+    parser.add_argument(
+        "--until",
+        type=float,
+        default=None,
+        help="last simulated time shown (default: the end, or the first --max-events events from --start on)",
+    )
     parser.add_argument("--colour", default="auto", choices=["auto", "disc", "group", "speed"], help="disc colours")
+    parser.add_argument("--arrows", action="store_true", help="draw velocity arrows (the page can switch them)")
     parser.add_argument(
         "--max-events", type=positive_int, default=None, metavar="E", help="refuse pages holding more events"
     )
@@ -59,11 +65,14 @@ def handle(args: argparse.Namespace) -> int:
             start=args.start,
             until=args.until,
             max_events=args.max_events or DEFAULT_MAX_EVENTS,
+            arrows=args.arrows,
         )
     except (ds.DiscsimError, OSError) as exc:
         print(f"discsim view: {exc}", file=sys.stderr)
         return 1
     t0, t1 = page.span
+    if page.note:
+        print(f"discsim view: {page.note}")
     print(f"discsim view: wrote {page.path} ({len(page.html):,} bytes, {page.events:,} events, t in [{t0:g}, {t1:g}])")
     print("  open it in a browser; Space plays and pauses, Left/Right step a frame, Shift+Left/Right an event")
     for line, _ in cut:

@@ -57,6 +57,7 @@ __all__ = [
     "read_stream",
     "replacing",
     "stream_extent",
+    "stream_index",
     "write_state",
 ]
 
@@ -378,6 +379,46 @@ def iter_stream(path, *, partial: bool = False) -> Iterator[tuple[dict, dict, np
                 raise CheckpointError(msg)
             expected += len(records)
             yield meta, {}, records, end
+
+
+def stream_index(path, *, partial: bool = False) -> tuple[dict, dict[str, np.ndarray], list[dict]]:
+    """The header of a record stream and the JSON of each chunk, without reading the records.
+
+    Follows the blocks' length fields and reads each chunk's JSON only (a few hundred bytes a chunk, so a
+    large file is indexed in milliseconds); the checksums are checked later, by whoever reads the chunks
+    (:func:`iter_stream`). Each chunk's dict is what was stored with it (``first``, ``count``, and e.g. the
+    ``time`` of an event log), plus ``offset``, where its block starts.
+
+    Raises:
+        CheckpointError: see :func:`iter_stream` (a damaged header, or a block past the end of the file
+            unless ``partial``).
+    """
+    path = Path(path)
+    size = path.stat().st_size
+    chunks: list[dict] = []
+    with open(path, "rb") as handle:
+        user, arrays, _, position = _open_stream(handle, path, size)
+        while position < size:
+            handle.seek(position)
+            head = handle.read(2 * _LENGTH.size)
+            if len(head) < 2 * _LENGTH.size:
+                body_len = json_len = size  # an incomplete block header
+            else:
+                body_len, json_len = _LENGTH.unpack_from(head, 0)[0], _LENGTH.unpack_from(head, _LENGTH.size)[0]
+            end = position + _LENGTH.size + body_len + _DIGEST
+            if end > size or json_len > min(body_len, _MAX_JSON):
+                if partial:
+                    break
+                msg = f"{path}: truncated at byte {size} (a block starting at byte {position} runs past the end)"
+                raise CheckpointError(msg)
+            try:
+                meta = json.loads(handle.read(json_len).decode("utf-8"))["meta"]
+            except (ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
+                msg = f"{path}: unreadable chunk at byte {position} ({exc}; the file is corrupted)"
+                raise CheckpointError(msg) from exc
+            chunks.append({**meta, "offset": position})
+            position = end
+    return user, arrays, chunks
 
 
 def read_stream(path, *, partial: bool = False) -> RecordStream:

@@ -6,6 +6,7 @@ the box, and whose records are :data:`~discsim.events.EVENT_DTYPE` rows.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -13,14 +14,26 @@ import numpy as np
 
 from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
-from discsim.io.container import read_stream
+from discsim.io.container import iter_stream, read_stream, stream_index
 from discsim.model import Box, Discs
-from discsim.trajectory import positions_from_log
+from discsim.trajectory import LastRecords, check_times, positions_from_log, replay
 
-__all__ = ["STREAM_KIND", "StreamedEvents", "read_events", "stream_header", "trajectory_from_events"]
+__all__ = [
+    "DEFAULT_CHUNK",
+    "STREAM_KIND",
+    "EventChunk",
+    "EventChunks",
+    "StreamedEvents",
+    "iter_events",
+    "read_events",
+    "stream_header",
+    "trajectory_from_events",
+]
 
 #: ``kind`` in the header of an event log written by ``run(record_to=...)``.
 STREAM_KIND = "discsim event log"
+#: Records per chunk that :func:`iter_events` hands out at most by default (89 bytes each: 5.8 MB).
+DEFAULT_CHUNK = 65_536
 
 
 def stream_header(
@@ -105,7 +118,7 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
     """Read an event log written by ``run(record_to=path)`` (either engine).
 
     Every chunk's checksum is verified. The whole log is loaded into memory
-    (89 bytes per event).
+    (89 bytes per event): :func:`iter_events` reads a large one chunk by chunk.
 
     Args:
         path: the log file.
@@ -134,18 +147,23 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
         True
     """
     stream = read_stream(path, partial=partial)
-    meta, arrays = stream.meta, stream.arrays
-    if not isinstance(meta, dict) or meta.get("kind") != STREAM_KIND:
-        msg = f"{path}: a discsim record stream, but not an event log"
-        raise CheckpointError(msg)
+    discs, box, start_time, run_id, ids = _header(path, stream.meta, stream.arrays)
     if stream.records.dtype != EVENT_DTYPE:
         msg = f"{path}: records of dtype {stream.records.dtype}, expected the event dtype"
+        raise CheckpointError(msg)
+    end_time = float(stream.last.get("time", start_time))
+    return StreamedEvents(stream.records, discs, box, start_time, end_time, run_id, ids)
+
+
+def _header(path, meta, arrays) -> tuple[Discs, Box, float, str, np.ndarray | None]:
+    """``(discs, box, start_time, run_id, ids)`` of an event log's header, checked."""
+    if not isinstance(meta, dict) or meta.get("kind") != STREAM_KIND:
+        msg = f"{path}: a discsim record stream, but not an event log"
         raise CheckpointError(msg)
     try:
         box = Box(**meta["box"])
         discs = Discs(arrays["positions"], arrays["velocities"], arrays["radii"], arrays["masses"], arrays["groups"])
         start_time = float(meta["start_time"])
-        end_time = float(stream.last.get("time", start_time))
         run_id = str(meta["run_id"])
         ids = arrays.get("ids")
         if ids is not None and np.shape(ids) != (len(discs),):
@@ -154,7 +172,140 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
     except (KeyError, TypeError, DiscsimError) as exc:
         msg = f"{path}: the event log's header is incomplete or invalid ({exc})"
         raise CheckpointError(msg) from exc
-    return StreamedEvents(stream.records, discs, box, start_time, end_time, run_id, ids)
+    return discs, box, start_time, run_id, ids
+
+
+@dataclass(frozen=True)
+class EventChunk:
+    """A slice of an event log, with where the log stood before it (yielded by :func:`iter_events`).
+
+    Attributes:
+        records: ``(R,)`` structured array of :data:`EVENT_DTYPE`, in time order.
+        before: a :class:`~discsim.trajectory.LastRecords`: each disc id's last record before ``records``
+            (its time ``(M,)``, position and velocity ``(M, 2)`` just after it, radius, mass and group
+            ``(M,)``; NaN for a disc not there), from which ``records`` go on exactly.
+        first: the index in the whole log of ``records[0]``.
+    """
+
+    records: np.ndarray
+    before: LastRecords
+    first: int
+
+
+@dataclass(frozen=True)
+class EventChunks:
+    """An event log on disk, read chunk by chunk: iterate over it for :class:`EventChunk` s (see :func:`iter_events`).
+
+    Attributes:
+        path: the log file. discs: the discs where the log starts (ids ``ids``, None: their indices).
+        box: the box. start_time, end_time: the span the log covers. run_id: the run that wrote it.
+        records: the number of records in the log (known from its index, before reading them).
+        chunk: records per chunk at most. start: the time the chunks start from (None: the log's start).
+        unwrapped: the ``before`` positions are unwrapped (periodic box).
+    """
+
+    path: Path
+    discs: Discs
+    ids: np.ndarray | None
+    box: Box
+    start_time: float
+    end_time: float
+    run_id: str
+    records: int
+    chunk: int
+    start: float | None
+    unwrapped: bool
+    partial: bool
+
+    def __iter__(self) -> Iterator[EventChunk]:
+        carry = LastRecords.at_start(self.discs, self.start_time, self.ids)
+        walk = iter_stream(self.path, partial=self.partial)
+        next(walk)  # the header
+        start = -np.inf if self.start is None else self.start
+        first = 0
+        for _meta, _arrays, records, _end in walk:
+            if records.dtype != EVENT_DTYPE:
+                msg = f"{self.path}: records of dtype {records.dtype}, expected the event dtype"
+                raise CheckpointError(msg)
+            if len(records) and records["time"].max() < start:  # wholly before the start: only where it leaves discs
+                carry = carry.after(records, self.box, unwrapped=self.unwrapped)
+                first += len(records)
+                continue
+            skip = int(np.count_nonzero(records["time"] < start)) if self.start is not None else 0
+            if skip:
+                carry = carry.after(records[:skip], self.box, unwrapped=self.unwrapped)
+            for at in range(skip, len(records), self.chunk):
+                piece = records[at : at + self.chunk]
+                yield EventChunk(piece, carry, first + at)
+                carry = carry.after(piece, self.box, unwrapped=self.unwrapped)
+            first += len(records)
+
+    def record_arrays(self) -> Iterator[np.ndarray]:
+        """The records alone, chunk by chunk from the log's start (no ``before`` states: faster)."""
+        walk = iter_stream(self.path, partial=self.partial)
+        next(walk)
+        for _meta, _arrays, records, _end in walk:
+            for at in range(0, len(records), self.chunk):
+                yield records[at : at + self.chunk]
+
+
+def iter_events(
+    path, *, chunk: int = DEFAULT_CHUNK, start: float | None = None, unwrapped: bool = False, partial: bool = False
+) -> EventChunks:
+    """Read an event log written by ``run(record_to=path)`` chunk by chunk: memory flat in the log's length.
+
+    Where :func:`read_events` loads the whole log (89 bytes an event), this holds one chunk of the file and
+    each disc's last record (about 80 bytes a disc). Each :class:`EventChunk` carries ``records`` ``(R,)``
+    (``R <= chunk``) and ``before``, where every disc stood before them, so any chunk can be replayed on
+    its own (:func:`discsim.trajectory.replay`). The header (box, span, number of records) is read at once,
+    from the file's index; the chunks, with their checksums, as they are iterated (again on each iteration).
+
+    Args:
+        path: the log file.
+        chunk: records per chunk at most (the file's own chunks are cut to this size).
+        start: begin with the records at or after this time: those before are read, to know where each disc
+            stood, but not handed out (the log is in time order).
+        unwrapped: keep ``before``'s positions unwrapped (continuous across periodic edges since the log's start).
+        partial: accept an incomplete last chunk (a run killed while writing it).
+
+    Returns:
+        An :class:`EventChunks`: iterate over it for the chunks.
+
+    Raises:
+        FileNotFoundError: if there is no such file.
+        InvalidArgumentError: for a ``chunk`` that is not a positive integer, or a ``start`` that is not a
+            finite time.
+        CheckpointError: see :func:`read_events` (a damaged chunk when it is reached).
+
+    Example:
+        >>> import os, tempfile, discsim as ds
+        >>> path = os.path.join(tempfile.mkdtemp(), "events.dse")
+        >>> sim = ds.EventDriven(*ds.random_gas(20, 0.3, seed=1), record=False).run(until=2.0, record_to=path)
+        >>> log = ds.iter_events(path, chunk=100)
+        >>> sizes = [len(c.records) for c in log]
+        >>> max(sizes) <= 100, sum(sizes) == log.records, log.end_time
+        (True, True, 2.0)
+        >>> late = next(iter(ds.iter_events(path, start=1.5)))
+        >>> bool(late.records["time"][0] >= 1.5), late.before.positions.shape
+        (True, (20, 2))
+    """
+    from discsim.errors import InvalidArgumentError
+
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        msg = f"chunk must be a positive integer (records per chunk), got {chunk!r}"
+        raise InvalidArgumentError(msg)
+    if start is not None and not (isinstance(start, (int, float, np.number)) and np.isfinite(start)):
+        msg = f"start must be a finite time or None, got {start!r}"
+        raise InvalidArgumentError(msg)
+    path = Path(path)
+    meta, arrays, chunks = stream_index(path, partial=partial)
+    discs, box, start_time, run_id, ids = _header(path, meta, arrays)
+    end_time = float(chunks[-1].get("time", start_time)) if chunks else start_time
+    total = sum(int(c.get("count", 0)) for c in chunks)
+    start = None if start is None else float(start)
+    return EventChunks(
+        path, discs, ids, box, start_time, end_time, run_id, total, int(chunk), start, unwrapped, partial
+    )
 
 
 def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndarray:
@@ -179,5 +330,9 @@ def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndar
         >>> bool((ds.trajectory_from_events(path, [0.3, 1.0]) == sim.trajectory([0.3, 1.0])).all())
         True
     """
-    log = source if isinstance(source, StreamedEvents) else read_events(Path(source))
-    return log.trajectory(times, unwrapped=unwrapped)
+    if isinstance(source, StreamedEvents):
+        return source.trajectory(times, unwrapped=unwrapped)
+    log = iter_events(Path(source), unwrapped=unwrapped)
+    times = check_times(times, log.start_time, log.end_time, "logged span")
+    origin = LastRecords.at_start(log.discs, log.start_time, log.ids)
+    return replay(log.record_arrays(), origin, times, log.box, unwrapped=unwrapped)

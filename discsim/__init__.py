@@ -14,6 +14,7 @@ The public API::
 """
 
 from discsim import scenarios
+from discsim._version import __version__ as __version__
 from discsim.analysis.compare import Comparison, compare
 from discsim.analysis.contacts import Contact, Contacts, contacts
 from discsim.analysis.dynamics import free_times, msd, vacf
@@ -62,8 +63,6 @@ from discsim.run.sweep import sweep
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
 from discsim.spatial import RayHit
 from discsim.view import View, view  # cheap (no matplotlib); binds ds.view to the function, not the module
-
-__version__ = "0.1.0"
 
 
 def __getattr__(name: str):

@@ -332,10 +332,10 @@ def sweep(
         if "<lambda>" in name or "<locals>" in name:
             msg = f"a cached sweep needs a task with a stable name (defined at module level), not {name}"
             raise InvalidArgumentError(msg)
-        from discsim import __version__
+        from discsim import _version
         from discsim.run.cache import SweepCache
 
-        store = SweepCache(cache, name, __version__)
+        store = SweepCache(cache, name, _version.__version__)
     jobs = [_Job(row, dict(point), seed) for row, (point, seed) in enumerate(itertools.product(points, seed_list))]
     return _run(pd, task, name, jobs, executor, store, int(retries), progress)
 

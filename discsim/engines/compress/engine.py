@@ -75,8 +75,16 @@ class Compression(Uneditable, Engine):
     :func:`compress`.
 
     Args:
-        discs, box, packing_fraction, growth_rate, seed, temperature, max_collisions, max_pressure,
-            epoch_collisions, backend: as for :func:`compress`.
+        discs: the starting discs (as for :func:`compress`, like every argument here).
+        box: the box, periodic or walled.
+        packing_fraction: the target.
+        growth_rate: mean diameter growth per unit time, in thermal speeds.
+        seed: seed of new velocities, or None to keep the directions given.
+        temperature: kT of the thermostat.
+        max_collisions: budget of collisions (None: none).
+        max_pressure: the reduced pressure Z taken for jamming.
+        epoch_collisions: collisions between two rescalings (default ``2 N``, at least 100).
+        backend: ``"auto"``, ``"numba"`` or ``"python"``.
 
     Example:
         >>> import discsim as ds

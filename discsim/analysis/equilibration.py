@@ -12,7 +12,10 @@ with ``fast=False, mintime=3``, and ``detectEquilibration``) to roundoff, withou
 
 Whether what is left still drifts is judged by Geweke's diagnostic (J. Geweke, in *Bayesian Statistics 4*,
 169 (1992)): the means of its first 10% and its last 50% compared in units of their standard errors (each
-from its own ``g``); a series at equilibrium gives a standard normal score.
+from its own ``g``); a series at equilibrium gives a standard normal score. A slow, steady drift of a
+few samples (the order of a structure still relaxing) is judged by the least-squares slope over its standard
+error, the residuals' variance inflated by their statistical inefficiency (the effective sample size of a
+regression on autocorrelated data; e.g. B. D. Santer et al., J. Geophys. Res. 105, 7337 (2000)).
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Equilibration", "detect_equilibration", "geweke_score", "statistical_inefficiency"]
+__all__ = ["Equilibration", "detect_equilibration", "geweke_score", "statistical_inefficiency", "trend_score"]
 
 #: The lag up to which the autocorrelation is summed even where it dips below zero (pymbar's ``mintime``).
 MIN_LAG = 3
@@ -37,8 +40,9 @@ def statistical_inefficiency(x) -> float:
 
     Example:
         >>> import numpy as np
-        >>> round(statistical_inefficiency(np.repeat(np.arange(100.0) % 2, 5)), 2)  # blocks of 5 equal samples
-        4.87
+        >>> white = np.random.default_rng(0).normal(size=2000)
+        >>> round(statistical_inefficiency(np.repeat(white, 5)), 2)  # blocks of 5 equal samples: g near 5
+        4.97
     """
     a = np.asarray(x, dtype=float)
     t = len(a)
@@ -116,3 +120,28 @@ def geweke_score(x, first: float = 0.1, last: float = 0.5) -> float:
     if spread == 0.0:
         return 0.0
     return float((head.mean() - tail.mean()) / spread)
+
+
+def trend_score(x) -> float:
+    """The least-squares slope of ``x`` ``(T,)`` against its index over its standard error, the residuals'
+    variance inflated by their statistical inefficiency. About standard normal at equilibrium; large for a steady
+    drift; 0 for fewer than 3 samples or a series on a straight line with no scatter.
+
+    Example:
+        >>> import numpy as np
+        >>> noise = np.random.default_rng(1).normal(size=100)
+        >>> abs(trend_score(noise)) < 3, trend_score(noise + np.linspace(3.0, 0.0, 100)) < -5
+        (True, True)
+    """
+    a = np.asarray(x, dtype=float)
+    t = len(a)
+    if t < 3:
+        return 0.0
+    index = np.arange(t) - (t - 1) / 2.0
+    spread = float(np.dot(index, index))
+    slope = float(np.dot(index, a - a.mean())) / spread
+    residuals = a - a.mean() - slope * index
+    variance = float(np.dot(residuals, residuals)) / (t - 2) * statistical_inefficiency(residuals) / spread
+    if variance <= 0.0:
+        return 0.0
+    return slope / math.sqrt(variance)

@@ -31,7 +31,14 @@ number of batches are independent; ``blocks=k`` gives the batch means over ``k``
 found by the automated equilibration detection of J. D. Chodera, J. Chem. Theory Comput. 12, 1799 (2016)
 (``since="auto"``), and a production series that still drifts (Geweke's diagnostic beyond 3), holds fewer
 than :data:`MIN_INDEPENDENT` independent samples, or starts more than half-way through the run raises an
-:class:`~discsim.errors.EquilibrationWarning`.
+:class:`~discsim.errors.EquilibrationWarning`. ``Z`` alone can look stationary while the structure is still
+relaxing (a lattice start at packing 0.70 melts over thousands of collisions per disc, and ``Z`` climbs with
+it by less than its noise per block), so where positions are at hand (a log in memory, or a Sampler that kept
+its frames) the global bond-orientational order ``|psi6|``, the slowest observable of dense discs (the one
+E. P. Bernard and W. Krauth, PRL 107, 155704 (2011), and M. Engel et al., PRE 87, 042134 (2013), judge
+equilibration by), is checked on :data:`ORDER_FRAMES` frames of the production span: a slow drift
+(:func:`~discsim.analysis.equilibration.trend_score` beyond :data:`ORDER_TREND_LIMIT`) or a transient (Geweke's
+score beyond :data:`ORDER_GEWEKE_LIMIT`) warns too.
 """
 
 from __future__ import annotations
@@ -43,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim._validate import is_count
-from discsim.analysis.equilibration import detect_equilibration, geweke_score, statistical_inefficiency
+from discsim.analysis.equilibration import detect_equilibration, geweke_score, statistical_inefficiency, trend_score
 from discsim.engines.record import collision_virials
 from discsim.errors import EquilibrationWarning, InvalidArgumentError, TimeError
 from discsim.events import WALL
@@ -68,6 +75,14 @@ SERIES_COLLISIONS = 10
 #: Geweke scores beyond this, or fewer independent samples than ``MIN_INDEPENDENT``, warn.
 GEWEKE_LIMIT = 3.0
 MIN_INDEPENDENT = 10
+#: Frames of the global psi6 that :func:`thermo` checks over the production span (when it has positions), and
+#: the trend (its least-squares slope over its standard error: a slow drift) and the Geweke score (a transient)
+#: beyond which it warns. On 64 frames of an AR(1) series at equilibrium, |trend| > 4 comes up 0.1% of the time
+#: with a correlation of 0.5 from frame to frame, 1.5% with 0.7 and 8% with 0.9 (3 independent samples in the
+#: span: a run that is short for its structure anyway).
+ORDER_FRAMES = 64
+ORDER_TREND_LIMIT = 4.0
+ORDER_GEWEKE_LIMIT = 5.0
 
 
 def packing_fraction(radii: np.ndarray, area: float) -> float:
@@ -166,6 +181,9 @@ class ThermoAverages:
             finds in the series from the ``since`` asked (equal to ``since`` when it finds none to skip).
         geweke: Geweke's score of the production series (first 10% against last 50%; about standard normal at
             equilibrium). drifting: whether the averages warned (:class:`~discsim.errors.EquilibrationWarning`).
+        order: ``(F,)`` the global ``|psi6|`` at :data:`ORDER_FRAMES` times of the production span, or empty when
+            no positions were at hand (a streamed log, a Sampler that kept no frames). order_independent: its
+            independent samples (``F / g``; NaN when empty).
     """
 
     since: float
@@ -189,6 +207,8 @@ class ThermoAverages:
     equilibrium_start: float
     geweke: float
     drifting: bool
+    order: np.ndarray
+    order_independent: float
     method: str = "statistical inefficiency"
 
     def __str__(self) -> str:
@@ -303,7 +323,8 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
 
     Warns:
         EquilibrationWarning: if the production series still drifts (Geweke's score beyond 3), holds fewer than
-            10 independent samples, or (``since="auto"``) starts after the first half of the run.
+            10 independent samples, or (``since="auto"``) starts after the first half of the run; or if the
+            global psi6 still relaxes over the span (see the module's Error bars and equilibration).
 
     Raises:
         InvalidArgumentError: if the run recorded nothing (``record=False`` and no stream), the engine has no
@@ -327,7 +348,18 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
             msg = "thermo() of a Sampler that has not observed a run yet"
             raise InvalidArgumentError(msg)
         edges, virial, collisions = _sampler_bins(fine, None if auto else since, blocks)
-        return _analyse(edges, virial, collisions, fine.masses, fine.box, fine.energy, fine.temperature, auto, blocks)
+        kept = getattr(source, "frames", None) if not isinstance(source, VirialBlocks) else None
+
+        def sampled_order(start: float, end: float) -> np.ndarray:
+            if kept is None:
+                return np.zeros(0)
+            inside = np.flatnonzero(kept.times >= start - 1e-9 * fine.width)
+            pick = inside[np.unique(np.linspace(0, len(inside) - 1, min(len(inside), ORDER_FRAMES)).astype(int))]
+            return _order(kept.positions[pick], fine.box) if len(inside) >= 2 else np.zeros(0)
+
+        return _analyse(
+            edges, virial, collisions, fine.masses, fine.box, fine.energy, fine.temperature, auto, blocks, sampled_order
+        )
     from discsim.analysis.frames import log_source
 
     engine = source if hasattr(source, "run_context") else None
@@ -354,7 +386,24 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
     segments = getattr(getattr(sim, "scene", None), "segments", ())
     conserved = bool(box.periodic) and not walls and not len(segments)
     kt = _temperature(masses, energy, np.asarray(holder.momentum(), dtype=float), conserved)
-    return _analyse(edges, virial, collisions, masses, box, energy, kt, auto, blocks)
+
+    def logged_order(start: float, end: float) -> np.ndarray:
+        if engine is None or not getattr(engine, "record", False):  # a streamed log: too costly to replay
+            return np.zeros(0)
+        from discsim.analysis.frames import frames
+
+        return _order(frames(engine, np.linspace(start, end, ORDER_FRAMES)).positions, box)
+
+    return _analyse(edges, virial, collisions, masses, box, energy, kt, auto, blocks, logged_order)
+
+
+def _order(positions: np.ndarray, box) -> np.ndarray:
+    """``(F,)`` the global ``|psi6|`` of ``(F, N, 2)`` positions."""
+    from discsim.analysis.structure import psi6
+
+    if positions.shape[1] < 7:  # six neighbours each: too few discs for a bond order
+        return np.zeros(0)
+    return np.atleast_1d(np.asarray(psi6(positions, box).order, dtype=float))
 
 
 def _check_since(since, start: float, end: float) -> float:
@@ -392,8 +441,11 @@ def _grouped(edges: np.ndarray, virial: np.ndarray, collisions: np.ndarray, grou
     return bounds, np.array([virial[g].sum() for g in groups]), np.array([collisions[g].sum() for g in groups])
 
 
-def _analyse(edges, virial, collisions, masses, box, energy, kt, auto: bool, blocks: int | None) -> ThermoAverages:
-    """The averages over fine bins ``edges`` ``(F + 1,)`` holding ``virial`` and ``collisions`` ``(F,)``."""
+def _analyse(
+    edges, virial, collisions, masses, box, energy, kt, auto: bool, blocks: int | None, order_of
+) -> ThermoAverages:
+    """The averages over fine bins ``edges`` ``(F + 1,)`` holding ``virial`` and ``collisions`` ``(F,)``;
+    ``order_of(start, end)`` gives the global ``|psi6|`` at frames of the production span (or nothing)."""
     if energy <= 0.0 or kt <= 0.0:
         msg = "thermo() needs moving discs: the kinetic energy is 0"
         raise InvalidArgumentError(msg)
@@ -439,20 +491,31 @@ def _analyse(edges, virial, collisions, masses, box, energy, kt, auto: bool, blo
 
         z_err, rate_err = mean_err(z_blocks, z), mean_err(2.0 * bc / (n * durations), rate)
     late = auto and t0 > len(series) // 2
-    drifting = abs(geweke) > GEWEKE_LIMIT or independent < MIN_INDEPENDENT or late
+    order = order_of(float(edges[start]), float(edges[-1]))
+    order_independent = len(order) / statistical_inefficiency(order) if len(order) else math.nan
+    order_trend = trend_score(order) if len(order) else 0.0
+    order_geweke = geweke_score(order) if len(order) else 0.0
+    relaxing = abs(order_trend) > ORDER_TREND_LIMIT or abs(order_geweke) > ORDER_GEWEKE_LIMIT
+    drifting = abs(geweke) > GEWEKE_LIMIT or independent < MIN_INDEPENDENT or late or relaxing
     if drifting:
         reasons = []
         if abs(geweke) > GEWEKE_LIMIT:
-            reasons.append(f"it still drifts (Geweke score {geweke:+.1f}: its first 10% against its last 50%)")
+            reasons.append(f"Z still drifts (Geweke score {geweke:+.1f}: its first 10% against its last 50%)")
         if independent < MIN_INDEPENDENT:
-            reasons.append(f"it holds only {independent:.1f} independent samples (g = {g:.3g} blocks)")
+            reasons.append(f"Z holds only {independent:.1f} independent samples (g = {g:.3g} blocks)")
         if late:
-            reasons.append("equilibrium was only reached in its second half")
+            reasons.append("Z only reaches equilibrium in the second half of the run")
+        if relaxing:
+            reasons.append(
+                f"the structure still relaxes: the global psi6 goes from {order[0]:.3g} to {order[-1]:.3g} with "
+                f"{order_independent:.1f} independent samples in {len(order)} frames (its trend {order_trend:+.1f} "
+                f"standard errors, Geweke {order_geweke:+.1f})"
+            )
         msg = (
-            f"thermo(): the Z series over t in [{edges[start]:g}, {edges[-1]:g}] is not a production run at "
-            f"equilibrium: {'; '.join(reasons)}. Automated equilibration detection (Chodera 2016) puts the start "
-            f"at t = {bounds[found.t0]:g}; pass since='auto' or run longer (Z = {z:.4f} +- {z_err:.4f} is not "
-            "trustworthy)"
+            f"thermo(): the run over t in [{edges[start]:g}, {edges[-1]:g}] is not a production run at equilibrium: "
+            f"{'; '.join(reasons)}. Automated equilibration detection (Chodera 2016) on Z puts the "
+            f"start at t = {bounds[found.t0]:g}; pass since='auto' or run longer (Z = {z:.4f} +- {z_err:.4f} is "
+            "not trustworthy)"
         )
         warnings.warn(msg, EquilibrationWarning, stacklevel=3)
     return ThermoAverages(
@@ -477,5 +540,7 @@ def _analyse(edges, virial, collisions, masses, box, energy, kt, auto: bool, blo
         equilibrium_start=float(bounds[found.t0]),
         geweke=geweke,
         drifting=drifting,
+        order=order,
+        order_independent=order_independent,
         method=method,
     )

@@ -9,6 +9,7 @@ import pytest
 import discsim as ds
 
 
+@pytest.mark.filterwarnings("ignore::discsim.EquilibrationWarning")  # from t = 0 the lattice melts: it warns
 @pytest.mark.parametrize("periodic", [True, False])
 def test_from_the_start_equals_the_engine_pressure(periodic):
     sim = ds.EventDriven(*ds.random_gas(300, 0.45, periodic=periodic, seed=2)).run(until=5.0)
@@ -74,6 +75,7 @@ def test_a_streamed_log_is_read_chunk_by_chunk(tmp_path):
     assert c.z == pytest.approx(a.z, rel=1e-12)
 
 
+@pytest.mark.filterwarnings("ignore::discsim.EquilibrationWarning")  # thermo(sampler) from t = 0
 def test_a_sampler_gathers_the_same_virial():
     discs, box = ds.random_gas(300, 0.4, seed=1)
     sim = ds.EventDriven(discs, box).run(until=5.0)
@@ -122,3 +124,13 @@ def test_plot_returns_axes():
     sim = ds.EventDriven(*ds.random_gas(100, 0.3, seed=1)).run(until=3.0)
     assert ds.thermo(sim, since=1.0).plot() is not None
     plt.close("all")
+
+
+def test_a_melting_lattice_warns_through_its_structure():
+    # From t = 0 the lattice's psi6 falls from 0.8 to the fluid's 0.05: the structure relaxes, and thermo says so.
+    sim = ds.EventDriven(*ds.random_gas(300, 0.45, seed=2)).run(until=5.0)
+    with pytest.warns(ds.EquilibrationWarning, match="the structure still relaxes: the global psi6"):
+        early = ds.thermo(sim)
+    assert early.drifting and early.order[0] > 0.5 > 0.2 > early.order[-1] and len(early.order) == 64
+    late = ds.thermo(sim, since=2.0)  # melted: no warning (pytest's filterwarnings turns none into errors here)
+    assert not late.drifting and late.order.max() < 0.2

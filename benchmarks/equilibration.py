@@ -68,7 +68,7 @@ def run(n: int, packing: float, short: float, long: float, start: str, seed: int
     begin = time.perf_counter()
     sim.run(events=int(short * n / 2))
     seconds = time.perf_counter() - begin
-    label = f"{start}, {short:g}/disc"
+    label = f"{start} {short:g}/disc"
     rows = [
         analyse(label, sim, sim.time / 4, sim, box, seconds, psi6_start),
         analyse(label, sim, "auto", sim, box, seconds, psi6_start),
@@ -81,7 +81,7 @@ def run(n: int, packing: float, short: float, long: float, start: str, seed: int
         begin = time.perf_counter()
         sim.run(events=int(long * n / 2), observers=[sampler])
         seconds = time.perf_counter() - begin
-        label = f"{start}, {long:g}/disc"
+        label = f"{start} {long:g}/disc"
         rows.append(analyse(label, sampler, sim.time / 4, sim, box, seconds, psi6_start))
         rows.append(analyse(label, sampler, "auto", sim, box, seconds, psi6_start))
         rows[-1]["start_seconds"] = rows[-2]["start_seconds"] = prepared

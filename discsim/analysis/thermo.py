@@ -312,7 +312,8 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
             (``run(record_to=...)``, read back chunk by chunk, so memory stays flat), a
             :class:`~discsim.io.streams.StreamedEvents` or the path of a streamed log; or a
             :class:`discsim.Sampler` that observed the run (which needs no log: its blocks are ``dt / 8``
-            long, and ``since`` is rounded up to a block's start).
+            long, and ``since`` is rounded up to a block's start). A log in memory is replayed at 64 times for
+            the psi6 check (a few seconds for 10,000 discs); a streamed log is not.
         since: average from this time on, to skip the melting of a starting lattice; ``"auto"``: from the start
             of production that automated equilibration detection (Chodera 2016) finds; None: from the start.
         blocks: None: error bars from the statistical inefficiency of the series; an integer >= 2: batch means

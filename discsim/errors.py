@@ -12,6 +12,7 @@ __all__ = [
     "CacheWarning",
     "CheckpointError",
     "DiscsimError",
+    "EquilibrationWarning",
     "Interrupted",
     "InvalidArgumentError",
     "InvalidDiscsError",
@@ -87,3 +88,8 @@ class Interrupted(KeyboardInterrupt):
 
     A ``KeyboardInterrupt``, so ``except KeyboardInterrupt`` catches it, and ``except Exception`` does not.
     """
+
+
+class EquilibrationWarning(UserWarning):
+    """A time average over a series that is not at equilibrium: it still drifts, or is too short to tell
+    (:func:`discsim.thermo`). A warning, not an error: the numbers are returned, with the reason."""

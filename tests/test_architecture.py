@@ -11,10 +11,10 @@ from paths import PACKAGE
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
     "ground": ["model", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled", "_progress", "_version"],
-    "model": ["scene", "scenarios", "events", "cells", "repair", "spatial"],
+    "model": ["scene", "events", "cells", "repair", "spatial"],
     "physics": ["physics", "kernels", "trajectory"],
     "engines": ["engines"],
-    "top": ["run", "io", "analysis", "cli", "plot", "view", "__init__", "__main__"],
+    "top": ["run", "io", "analysis", "cli", "plot", "view", "scenarios", "__init__", "__main__"],
 }
 LEVEL = {name: level for level, names in enumerate(FLOORS.values()) for name in names}
 

@@ -1,8 +1,9 @@
 """The physics summary that ``discsim run`` prints and writes at the end of a run.
 
-Collisions, collisions/s, the energy drift, the deepest overlap, the pressure and Z = PA/NkT (from the start,
-and from ``--since`` on with batch-means error bars) next to Henderson's equation of state, and what the event
-log costs on disk.
+Collisions, collisions/s, the energy drift, the deepest overlap, the canonical pressure and Z = beta P A / N
+(``kT = K / (N - 1)`` in a periodic box, :func:`discsim.thermo`; from the start, and from ``--since`` on with
+error bars from the correlation time and a flag when the series still drifts) next to Henderson's equation of
+state, and what the event log costs on disk.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ def run_summary(
         "collisions_per_s": (counts["collisions"] - collisions0) / seconds if seconds > 0 else float("nan"),
         "energy_drift": (sim.kinetic_energy() - e0) / e0,
         "max_overlap": sim.max_overlap,
-        "pressure": sim.pressure() if sim.time > 0 else float("nan"),
+        "pressure": canonical_pressure(sim) if sim.time > 0 else float("nan"),
         "Z_from_start": ds.compressibility_factor(sim) if sim.time > 0 else float("nan"),
         **equilibrated(sim, args),
         "henderson_Z": float(ds.henderson_z(args.packing)),
@@ -54,17 +55,40 @@ def run_summary(
     }
 
 
-def equilibrated(sim: EventDriven, args: argparse.Namespace) -> dict[str, float]:
-    """P and Z from ``--since`` on, with batch-means error bars (:func:`discsim.thermo`), read from the log on disk."""
+def canonical_pressure(sim: EventDriven) -> float:
+    """The canonical ``P = Z N kT / A`` from the start (the engine's ``pressure()`` is the mechanical one)."""
+    import numpy as np
+
+    import discsim as ds
+    from discsim.analysis.thermo import kinetic_temperature
+
+    n = int(np.count_nonzero(np.isfinite(np.asarray(sim.discs.masses, dtype=float))))
+    return ds.compressibility_factor(sim) * n * kinetic_temperature(sim) / sim.box.area
+
+
+def equilibrated(sim: EventDriven, args: argparse.Namespace) -> dict[str, Any]:
+    """P and Z from ``--since`` on, with error bars from the correlation time (:func:`discsim.thermo`), read from
+    the log on disk; ``Z_drifting`` says whether the series still drifts (the warning is kept for the table)."""
+    import warnings
+
     import discsim as ds
 
     since = args.until / 5.0 if args.since is None else args.since
     try:
-        t = ds.thermo(sim, since=since)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ds.EquilibrationWarning)
+            t = ds.thermo(sim, since=since)
     except ds.DiscsimError:  # --since outside the run, or a run of zero length
         nan = float("nan")
-        return {"since": since, "Z": nan, "Z_err": nan, "pressure_since": nan, "pressure_err": nan}
-    return {"since": t.since, "Z": t.z, "Z_err": t.z_err, "pressure_since": t.pressure, "pressure_err": t.pressure_err}
+        return {"since": since, "Z": nan, "Z_err": nan, "pressure_since": nan, "pressure_err": nan, "Z_drifting": False}
+    return {
+        "since": t.since,
+        "Z": t.z,
+        "Z_err": t.z_err,
+        "pressure_since": t.pressure,
+        "pressure_err": t.pressure_err,
+        "Z_drifting": t.drifting,
+    }
 
 
 def print_run_summary(s: dict[str, Any], resumed: bool) -> None:
@@ -86,12 +110,13 @@ def print_run_summary(s: dict[str, Any], resumed: bool) -> None:
         (
             "pressure P",
             f"{s['pressure_since']:.6g} ± {s['pressure_err']:.2g}",
-            f"energy per area, collision virial since t = {s['since']:g} (batch means)",
+            f"energy per area, canonical (kT = K/(N-1)), since t = {s['since']:g}",
         ),
         (
             "Z = PA/NkT",
             f"{s['Z']:.4f} ± {s['Z_err']:.4f}",
-            f"Henderson: {s['henderson_Z']:.4f}; averaged from t = 0: {s['Z_from_start']:.4f}",
+            f"Henderson: {s['henderson_Z']:.4f}; averaged from t = 0: {s['Z_from_start']:.4f}"
+            + ("; STILL DRIFTING: run longer" if s.get("Z_drifting") else ""),
         ),
         ("events on disk", f"{s['events_on_disk']:,}", f"{s['bytes_per_event']:.1f} bytes/event"),
     ]

@@ -21,7 +21,7 @@ import numpy as np
 from discsim._validate import positive_finite
 from discsim.analysis.dynamics import free_times_of
 from discsim.analysis.frames import Frames, states_at
-from discsim.analysis.thermo import VirialBlocks
+from discsim.analysis.thermo import VirialBlocks, kinetic_temperature
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, REMOVE
 from discsim.model import frame_count
@@ -137,7 +137,9 @@ class Sampler(Observer):
             self._engine_id = id(engine)
             self._origin = origin = engine.time
             masses = np.asarray(engine.discs.masses, dtype=float)
-            self.virial_blocks = VirialBlocks(origin, self.dt / 8, masses, engine.box, engine.kinetic_energy())
+            self.virial_blocks = VirialBlocks(
+                origin, self.dt / 8, masses, engine.box, engine.kinetic_energy(), kinetic_temperature(engine)
+            )
             self._last = np.full(len(engine.discs), np.nan)
         self._state = (engine.time, engine.unwrapped_positions, engine.velocities)
         self._units = engine._units()

@@ -37,7 +37,8 @@ def add_parser(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) 
             f"OUT/{RUN_FILES['events']} and checkpointing to OUT/{RUN_FILES['checkpoint']}. Killed at any "
             "moment, the run continues with --resume and ends exactly where it would have ended. At the end "
             "it prints collisions, collisions/s, the energy drift, the pressure and Z = PA/NkT averaged from "
-            "--since on (with batch-means error bars) next to Henderson's equation of state, and writes them to "
+            "--since on (error bars from the series' correlation time, a warning if it still drifts) next to "
+            "Henderson's equation of state, and writes them to "
             f"OUT/{RUN_FILES['summary']}."
         ),
     )

@@ -6,6 +6,9 @@ numbers, bit for bit, on any worker (both event-driven backends give the same ev
 
 - :func:`equation_of_state`: pressure, ``Z`` and collision rate of a hard-disc gas at one packing
   fraction, with batch-means error bars, beside Henderson's ``Z``.
+- :func:`hard_disc_pressure`: ``beta P d^2`` of monodisperse hard discs at one packing fraction from either
+  algorithm, event-driven molecular dynamics or event-chain Monte Carlo, with the task's seconds (the
+  hexatic benchmark's task).
 - :func:`pit_accuracy`: one cell of the PIT accuracy map (a response policy at a frame step and packing
   fraction): what fraction of the exact collisions PIT misses, how far it turns the outgoing directions and
   how late it responds, as counts and sums that pool over seeds.
@@ -20,7 +23,7 @@ import numpy as np
 
 from discsim.errors import InvalidArgumentError
 
-__all__ = ["equation_of_state", "pit_accuracy"]
+__all__ = ["equation_of_state", "hard_disc_pressure", "pit_accuracy"]
 
 
 def equation_of_state(
@@ -90,6 +93,102 @@ def equation_of_state(
         "collisions": averages.collisions,
         "time": span,
         "henderson_z": float(henderson_z(packing_fraction)),
+    }
+
+
+#: The algorithms :func:`hard_disc_pressure` runs.
+ALGORITHMS = ("edmd", "ecmc")
+
+
+def hard_disc_pressure(
+    algorithm: str,
+    packing_fraction: float,
+    *,
+    seed: int = 0,
+    n: int = 256,
+    equilibrate: float = 10.0,
+    measure: float = 40.0,
+    blocks: int = 8,
+    start: str = "lattice",
+    backend: str = "auto",
+) -> dict:
+    """``beta P d^2`` and ``Z`` of ``n`` equal hard discs (diameter ``d``) in a square periodic box, by either
+    algorithm, with the seconds it took.
+
+    ``"edmd"``: :class:`discsim.EventDriven` (``kT = 1``), ``equilibrate`` then ``measure`` collisions per disc
+    (converted to time with Enskog's rate), ``Z`` from the collision virial at the canonical ``kT``
+    (:func:`discsim.compressibility_factor`). ``"ecmc"``: :class:`discsim.EventChain`, ``equilibrate`` then
+    ``measure`` chains per disc (chains of half the box), ``Z`` from the lifts. Either way the measured span is
+    cut into ``blocks`` consecutive blocks, each measured afresh, and the error bar is their standard error
+    (blocks longer than the correlation time make it honest; compare seeds to check). ``beta P d^2 = Z * 4 phi
+    / pi``.
+
+    Args:
+        algorithm: ``"edmd"`` or ``"ecmc"``.
+        packing_fraction: ``N pi d^2 / (4 A)``.
+        seed: the start's seed (and the chains'). n: discs (a square number gives a square box's lattice).
+        equilibrate, measure: collisions per disc (EDMD) or chains per disc (ECMC), >= 0 and > 0.
+        blocks: blocks of the measured span (>= 2).
+        start: ``"lattice"`` or ``"random"`` (:func:`discsim.random_gas`).
+        backend: ``"auto"``, ``"python"`` or ``"numba"``.
+
+    Returns:
+        ``z``, ``z_err``, ``beta_p_d2``, ``beta_p_d2_err``, ``work`` (collisions, or lifts, measured) and
+        ``seconds`` (the task's wall time, its start and equilibration included).
+
+    Example:
+        >>> out = hard_disc_pressure("ecmc", 0.5, n=64, equilibrate=2, measure=8, seed=1, backend="python")
+        >>> 3.0 < out["z"] < 5.0, abs(out["beta_p_d2"] - out["z"] * 2.0 / math.pi) < 1e-12
+        (True, True)
+    """
+    from discsim.analysis.theory import enskog_collision_rate
+    from discsim.analysis.thermo import compressibility_factor
+    from discsim.engines.event_chain import EventChain
+    from discsim.engines.event_driven import EventDriven
+    from discsim.scenarios import random_gas
+
+    if algorithm not in ALGORITHMS:
+        msg = f"algorithm must be one of {list(ALGORITHMS)}, got {algorithm!r}"
+        raise InvalidArgumentError(msg)
+    for name, value in (("equilibrate", equilibrate), ("measure", measure)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value >= 0 and math.isfinite(value)):
+            msg = f"{name} must be a number >= 0 (collisions or chains per disc), got {value!r}"
+            raise InvalidArgumentError(msg)
+    if not measure > 0 or isinstance(blocks, bool) or not isinstance(blocks, int) or blocks < 2:
+        msg = f"measure must be positive and blocks an integer >= 2, got {measure!r} and {blocks!r}"
+        raise InvalidArgumentError(msg)
+    began = time.perf_counter()
+    discs, box = random_gas(n, packing_fraction, periodic=True, seed=seed, start=start)
+    zs, work = [], 0
+    if algorithm == "edmd":
+        rate = float(enskog_collision_rate(packing_fraction))
+        if equilibrate > 0:
+            discs = EventDriven(discs, box, record=False, backend=backend).run(until=equilibrate / rate).snapshot()
+        for _ in range(blocks):
+            sim = EventDriven(discs, box, record=False, backend=backend).run(until=measure / blocks / rate)
+            zs.append(compressibility_factor(sim))
+            work += sim.counts["collisions"]
+            discs = sim.snapshot()
+    else:
+        chain = EventChain(discs, box, seed=seed, backend=backend)
+        chain.run(chains=max(0, round(equilibrate * n)))
+        per_block = max(1, round(measure * n / blocks))
+        for _ in range(blocks):
+            before = chain.state()
+            chain.run(chains=per_block)
+            after = chain.state()
+            zs.append(1.0 + (after.separation - before.separation) / (per_block * chain.chain_length))
+            work += after.lifts - before.lifts
+    z = float(np.mean(zs))
+    z_err = float(np.std(zs, ddof=1) / math.sqrt(blocks))
+    scale = 4.0 * packing_fraction / math.pi
+    return {
+        "z": z,
+        "z_err": z_err,
+        "beta_p_d2": z * scale,
+        "beta_p_d2_err": z_err * scale,
+        "work": int(work),
+        "seconds": time.perf_counter() - began,
     }
 
 

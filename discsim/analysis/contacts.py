@@ -13,6 +13,7 @@ or an obstacle).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -22,7 +23,7 @@ from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION, WALL
 from discsim.trajectory import log_start
 
-__all__ = ["Contact", "Contacts", "contacts", "contacts_of"]
+__all__ = ["Contact", "Contacts", "contact_of_record", "contacts", "contacts_of"]
 
 #: ``Contacts.surface`` of the four walls of the box (segments are numbered 0, 1, ...).
 LEFT, RIGHT, BOTTOM, TOP = -1, -2, -3, -4
@@ -190,3 +191,47 @@ def contacts_of(events, velocities, masses, radii, box, segments=()) -> Contacts
     if box.periodic:
         point = box.wrap(point)
     return Contacts(physical, ev["time"].copy(), kind, i, j, point, normal, impulse, speed, surface)
+
+
+def contact_of_record(rec, i: int, j: int, before_i, before_j, masses, radii, box, segments=()) -> Contact:
+    """The :class:`Contact` of one collision or wall record ``rec`` (a row of :data:`~discsim.events.EVENT_DTYPE`),
+    in plain floats: the floats :func:`contacts_of` gives for it, without its arrays (what a callback run after
+    every event needs: about a tenth of the time).
+
+    Args:
+        rec: the record; ``i``, ``j``: its discs as indices now (``j = -1`` at a wall).
+        before_i, before_j: ``(vx, vy)`` of ``i`` and ``j`` just before (``before_j`` unused at a wall).
+        masses, radii: ``(N,)``. box, segments: the scene's.
+    """
+    t, xi, yi, vxi, vyi = float(rec["time"]), float(rec["xi"]), float(rec["yi"]), float(rec["vxi"]), float(rec["vyi"])
+    vxi0, vyi0 = float(before_i[0]), float(before_i[1])
+    ri, mi = float(radii[i]), float(masses[i])
+    if int(rec["kind"]) == COLLISION:
+        dx, dy = float(rec["xj"]) - xi, float(rec["yj"]) - yi
+        if box.periodic:
+            dx -= box.width * round(dx / box.width)
+            dy -= box.height * round(dy / box.height)
+        h = math.hypot(dx, dy)
+        nx, ny = dx / h, dy / h
+        vxj, vyj, vxj0, vyj0 = float(rec["vxj"]), float(rec["vyj"]), float(before_j[0]), float(before_j[1])
+        if math.isfinite(mi):
+            impulse = -mi * ((vxi - vxi0) * nx + (vyi - vyi0) * ny)
+        else:
+            impulse = float(masses[j]) * ((vxj - vxj0) * nx + (vyj - vyj0) * ny)
+        speed = (vxi0 - vxj0) * nx + (vyi0 - vyj0) * ny
+        kind, surface = "collision", -5
+    else:
+        dvx, dvy = vxi - vxi0, vyi - vyi0
+        size = math.hypot(dvx, dvy)
+        scale = size if size > 0 else math.nan
+        nx, ny = -dvx / scale, -dvy / scale
+        impulse = mi * size
+        speed = vxi0 * nx + vyi0 * ny
+        gaps = [xi - ri, box.width - ri - xi, yi - ri, box.height - ri - yi]
+        gaps += [float(seg.distance(np.array([[xi, yi]]))[0]) - ri for seg in segments]
+        nearest = min(range(len(gaps)), key=lambda k: abs(gaps[k]))
+        kind, surface = ("wall", -1 - nearest) if nearest < 4 else ("segment", nearest - 4)
+    px, py = xi + nx * ri, yi + ny * ri
+    if box.periodic:
+        px, py = (float(v) for v in box.wrap(np.array([px, py])))
+    return Contact(t, kind, i, j, np.array([px, py]), np.array([nx, ny]), impulse, speed, surface)

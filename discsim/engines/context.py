@@ -21,7 +21,26 @@ import numpy as np
 from discsim.events import EventLog
 from discsim.model import Discs
 
-__all__ = ["RunContext"]
+__all__ = ["LookOnly", "RunContext"]
+
+
+class LookOnly:
+    """A ``sim.on(kind, fn, changes=False)`` callback: ``fn`` only looks, so the run need not stop after each event.
+
+    Calls ``fn`` as given; the driver's callback observer (:class:`discsim.run.handlers.EventHandlers`) tells it
+    from a callback that may change the simulation by this type.
+    """
+
+    __slots__ = ("fn",)
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def __call__(self, sim, contact):
+        return self.fn(sim, contact)
+
+    def __repr__(self) -> str:
+        return f"LookOnly({getattr(self.fn, '__qualname__', self.fn)!r})"
 
 
 class RunContext:
@@ -41,7 +60,8 @@ class RunContext:
         origin (tuple[Discs, array | None] | None): ``(discs, ids)`` where the log starts, once the discs
             changed (the engine's ``discs`` are then today's); None: the engine's ``discs`` and their indices.
         structure (int): ``add_discs`` / ``remove_discs`` calls so far (observers notice the disc set changed).
-        handlers (dict[str, list]): the ``sim.on(kind, fn)`` callbacks by kind.
+        handlers (dict[str, list]): the ``sim.on(kind, fn)`` callbacks by kind, in the order given (those given
+            with ``changes=False`` wrapped in :class:`LookOnly`).
         serving (bool): the driver is between two chunks of a run, serving its observers and callbacks; the
             engine refuses ``step()`` and ``run()`` meanwhile (a callback may change discs, not advance them).
     """

@@ -113,3 +113,60 @@ def test_a_callback_that_advances_the_engine_is_refused_before_anything_changes(
     sim.run(until=5.0)
     assert sim.positions.tobytes() == reference.positions.tobytes()
     assert sim.events.tobytes() == reference.events.tobytes()
+
+
+# --- callbacks that only look: changes=False (issue 28, item 5) ------------------------------------------------
+def _contacts_seen(sim, until, changes):
+    seen = []
+    sim.on("collision", lambda s, c: seen.append(c), changes=changes)
+    sim.on("wall", lambda s, c: seen.append(c), changes=changes)
+    sim.run(until=until)
+    return seen
+
+
+def test_look_only_callbacks_see_every_contact_of_the_exact_ones_and_change_nothing(every_backend):
+    discs, box = ds.random_gas(120, 0.35, periodic=False, seed=6)
+    plain = ds.EventDriven(discs, box, record=False).run(until=3.0)
+    exact = _contacts_seen(ds.EventDriven(discs, box, record=False), 3.0, changes=True)
+    looking = ds.EventDriven(discs, box, record=False)
+    seen = _contacts_seen(looking, 3.0, changes=False)
+    assert len(seen) == len(exact) == plain.counts["collisions"] + plain.counts["wall_hits"] > 100
+    for a, b in zip(seen, exact):
+        assert (a.time, a.kind, a.i, a.j, a.surface) == (b.time, b.kind, b.i, b.j, b.surface)
+        np.testing.assert_allclose(a.point, b.point, rtol=0, atol=1e-12)
+        assert a.impulse == pytest.approx(b.impulse, rel=1e-12) and a.speed == pytest.approx(b.speed, rel=1e-12)
+    assert looking.positions.tobytes() == plain.positions.tobytes()
+
+
+def test_look_only_callbacks_run_in_chunks_and_exact_ones_stop_at_every_event(every_backend):
+    discs, box = ds.random_gas(200, 0.3, seed=2)
+    chunks = []
+    sim = ds.EventDriven(discs, box, record=False)
+    sim.on("collision", lambda s, c: chunks.append(s.time), changes=False).run(events=3000)
+    assert len(chunks) == 3000 and len(set(chunks)) <= 2  # the chunks' ends, not the events' times
+    both = ds.EventDriven(discs, box, record=False)
+    order = []
+    both.on("collision", lambda s, c: order.append(("look", s.time == c.time)), changes=False)
+    both.on("collision", lambda s, c: order.append(("exact", s.time == c.time)))
+    both.run(events=50)
+    assert order == [("look", True), ("exact", True)] * 50  # with an exact one, every event stops the run
+
+
+def test_a_look_only_callback_that_changes_the_run_is_refused_by_name(every_backend):
+    discs, box = ds.random_gas(60, 0.3, seed=3)
+    sim = ds.EventDriven(discs, box)
+
+    def push(sim, contact):
+        sim.apply_impulse([contact.i], [0.0, 1.0])
+
+    sim.on("collision", push, changes=False)
+    with pytest.raises(ds.InvalidArgumentError, match=r"sim.on\('collision', .*push, changes=False\) changed"):
+        sim.run(events=500)
+    sim._check()
+
+
+def test_changes_takes_true_or_false():
+    sim = ds.EventDriven(ds.Discs([[2.0, 2.0]], [[1.0, 0.0]], 0.5), ds.Box(10, 5))
+    with pytest.raises(ds.InvalidArgumentError, match="changes=...\\) takes True or False, got 'no'"):
+        sim.on("wall", print, changes="no")
+    assert not sim.run_context.handlers

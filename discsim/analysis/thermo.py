@@ -309,7 +309,8 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
 
     Args:
         source: an engine (event-driven or fixed-step) that recorded its log (``record=True``) or streamed it
-            (``run(record_to=...)``, read back chunk by chunk, so memory stays flat), a
+            (``run(record_to=...)``, read back chunk by chunk, so memory stays flat; after ``add_discs`` or
+            ``remove_discs``, the span since the last such change, the discs being today's), a
             :class:`~discsim.io.streams.StreamedEvents` or the path of a streamed log; or a
             :class:`discsim.Sampler` that observed the run (which needs no log: its blocks are ``dt / 8``
             long, and ``since`` is rounded up to a block's start). A log in memory is replayed at 64 times for
@@ -361,17 +362,31 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
         return _analyse(
             edges, virial, collisions, fine.masses, fine.box, fine.energy, fine.temperature, auto, blocks, sampled_order
         )
-    from discsim.analysis.frames import log_source
+    from discsim.analysis.frames import _log_source, log_source
 
     engine = source if hasattr(source, "run_context") else None
     if engine is not None:
         _check_pressure_engine(engine, "thermo()")
-    chunks, discs, box, start, end, sim = log_source(source, "thermo()")
+    changed = engine is not None and engine.run_context.origin is not None
+    if engine is not None and changed:  # discs added or removed: the span since the last change, today's discs
+        chunks, _, box, start, end, sim = _log_source(engine, "thermo()")
+        discs = engine.discs
+        start = _last_change(chunks, start)
+        if since is not None and not auto and isinstance(since, (int, float)) and since < start:
+            msg = (
+                f"since={since!r} is before the last change of the discs (add_discs / remove_discs) at time "
+                f"{start!r}: thermo() averages a fixed set of discs, from then on"
+            )
+            raise TimeError(msg)
+        masses = np.full(engine.run_context.next_id, np.nan)  # by id: the log names the discs by id
+        masses[engine.ids] = discs.masses
+    else:
+        chunks, discs, box, start, end, sim = log_source(source, "thermo()")
+        masses = np.asarray(discs.masses, dtype=float)
     first = _check_since(None if auto else since, start, end)
     bins = LOG_BINS if blocks is None else blocks * math.ceil(LOG_BINS / blocks)  # equal batches
     edges = np.linspace(first, end, bins + 1)
     edges[-1] = end
-    masses = np.asarray(discs.masses, dtype=float)
     virial, collisions = np.zeros(bins), np.zeros(bins, dtype=np.int64)
     walls = False
     for events in chunks():
@@ -384,12 +399,13 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
         collisions += np.bincount(k, minlength=bins)
     holder = sim if sim is not None else discs
     energy = holder.kinetic_energy()
+    masses = np.asarray(discs.masses, dtype=float)  # today's discs, by index
     segments = getattr(getattr(sim, "scene", None), "segments", ())
     conserved = bool(box.periodic) and not walls and not len(segments)
     kt = _temperature(masses, energy, np.asarray(holder.momentum(), dtype=float), conserved)
 
     def logged_order(start: float, end: float) -> np.ndarray:
-        if engine is None or not getattr(engine, "record", False):  # a streamed log: too costly to replay
+        if engine is None or not getattr(engine, "record", False) or changed:  # a streamed log: too costly to replay
             return np.zeros(0)
         from discsim.analysis.frames import frames
 
@@ -405,6 +421,18 @@ def _order(positions: np.ndarray, box) -> np.ndarray:
     if positions.shape[1] < 7:  # six neighbours each: too few discs for a bond order
         return np.zeros(0)
     return np.atleast_1d(np.asarray(psi6(positions, box).order, dtype=float))
+
+
+def _last_change(chunks, start: float) -> float:
+    """The time of the log's last ``ADD`` or ``REMOVE`` record (``start`` if none)."""
+    from discsim.events import ADD, REMOVE
+
+    last = start
+    for records in chunks():
+        changed = records["time"][(records["kind"] == ADD) | (records["kind"] == REMOVE)]
+        if len(changed):
+            last = max(last, float(changed.max()))
+    return last
 
 
 def _check_since(since, start: float, end: float) -> float:

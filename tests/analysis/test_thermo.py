@@ -134,3 +134,35 @@ def test_a_melting_lattice_warns_through_its_structure():
     assert early.drifting and early.order[0] > 0.5 > 0.2 > early.order[-1] and len(early.order) == 64
     late = ds.thermo(sim, since=2.0)  # melted: no warning (pytest's filterwarnings turns none into errors here)
     assert not late.drifting and late.order.max() < 0.2
+
+
+def test_a_run_whose_discs_changed_is_averaged_since_the_last_change(every_backend, tmp_path):
+    """Issue 31, item 1: thermo refused any run that added or removed discs. It now averages the span since the
+    last change, where the discs are today's: the same numbers, bit for bit, as a fresh engine from that state."""
+    import warnings
+
+    discs, box = ds.random_gas(200, 0.4, seed=2)
+    sim = ds.EventDriven(discs, box).run(until=1.0)
+    where = sim.positions[0]
+    sim.remove_discs([0, 5])
+    sim.add_discs(ds.Discs([where], [[0.3, -0.2]], discs.radii[0]))  # where disc 0 was: a free spot
+    sim.run(until=1.5)
+    sim.remove_discs([7])
+    state = sim.snapshot()
+    sim.run(until=9.0)
+    fresh = ds.EventDriven(state, box).run(until=7.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ds.EquilibrationWarning)
+        ours, theirs = ds.thermo(sim), ds.thermo(fresh)
+        later = ds.thermo(sim, since=4.0)
+    assert ours.since == 1.5 and later.since == 4.0
+    assert (ours.z, ours.z_err, ours.collisions) == (theirs.z, theirs.z_err, theirs.collisions)
+    with pytest.raises(ds.TimeError, match=r"since=1.2 is before the last change of the discs .* at time 1.5"):
+        ds.thermo(sim, since=1.2)
+    streamed = ds.EventDriven(discs, box, record=False)
+    streamed.run(until=1.0, record_to=tmp_path / "log.dse")
+    streamed.remove_discs([3])
+    streamed.run(until=6.0, record_to=tmp_path / "log.dse")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ds.EquilibrationWarning)
+        assert ds.thermo(streamed).since == 1.0

@@ -295,8 +295,6 @@ def test_consumers_of_a_fixed_set_of_discs_refuse_a_changed_run(every_backend, t
     sim.run(until=1.0)
     with pytest.raises(ds.InvalidArgumentError, match="fixed set of discs"):
         ds.frames(sim, [0.5, 1.0])
-    with pytest.raises(ds.InvalidArgumentError, match="fixed set of discs"):
-        ds.thermo(sim)
     with pytest.raises(ds.InvalidArgumentError, match="added or removed"):
         ds.compare(sim, ds.FixedStep(discs, box, dt=0.01).run(until=1.0))
     sampler = ds.Sampler(dt=0.25)

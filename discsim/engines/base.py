@@ -343,6 +343,28 @@ class Engine(DiscEditing, EventRecord, SpatialQueries, ABC):
         )
         return self
 
+    def _count_only(self, until, count, events, record_to, name: str, no_time: str, no_log: str):
+        """The count of a ``run()`` that takes no stop time and streams no log (an engine whose unit is not an
+        event in time: a compression's epoch, an event chain): ``count`` (named ``name``) or its other name
+        ``events``, as :func:`discsim.resume` passes it.
+
+        Raises:
+            InvalidArgumentError: ``until`` given (``no_time`` says why), ``record_to`` given (``no_log``), or
+                both names of the count.
+        """
+        if until is not None:
+            msg = f"{no_time}: give {name}=..., not until={until!r}"
+            raise InvalidArgumentError(msg)
+        if record_to is not None:
+            msg = f"{no_log}: record_to is not taken"
+            raise InvalidArgumentError(msg)
+        if events is not None:
+            if count is not None:
+                msg = f"give {name}=... or events=..., not both: {name}={count!r}, events={events!r}"
+                raise InvalidArgumentError(msg)
+            count = events
+        return count
+
     def save(self, path):
         """Write the whole state to one file, so that :func:`discsim.load` continues bit for bit.
 

@@ -300,17 +300,10 @@ class Compression(Uneditable, Engine):
             InvalidArgumentError: ``until`` or ``record_to`` given, ``epochs`` not a whole number >= 0, or
                 ``epochs`` and ``events`` both given.
         """
-        if until is not None:
-            msg = f"a compression runs by epochs, not to a time: give epochs=... or nothing, not until={until!r}"
-            raise InvalidArgumentError(msg)
-        if record_to is not None:
-            msg = "a compression keeps no event log (the discs grow): record_to is not taken"
-            raise InvalidArgumentError(msg)
-        if events is not None:
-            if epochs is not None:
-                msg = f"give epochs=... or events=..., not both: epochs={epochs!r}, events={events!r}"
-                raise InvalidArgumentError(msg)
-            epochs = events
+        epochs = self._count_only(
+            until, epochs, events, record_to, "epochs", "a compression runs by epochs, not to a time (or to its end)",
+            "a compression keeps no event log (the discs grow)",
+        )  # fmt: skip
         return super().run(
             None,
             events=epochs,

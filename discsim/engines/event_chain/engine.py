@@ -221,17 +221,10 @@ class EventChain(Uneditable, Engine):
             InvalidArgumentError: ``until`` or ``record_to`` given (no time, no event log), no count, or
                 ``chains`` and ``events`` both given.
         """
-        if until is not None:
-            msg = f"an event chain has no physical time: give chains=..., not until={until!r}"
-            raise InvalidArgumentError(msg)
-        if record_to is not None:
-            msg = "an event chain keeps no event log: record_to is not taken"
-            raise InvalidArgumentError(msg)
-        if events is not None:
-            if chains is not None:
-                msg = f"give chains=... or events=..., not both: chains={chains!r}, events={events!r}"
-                raise InvalidArgumentError(msg)
-            chains = events
+        chains = self._count_only(
+            until, chains, events, record_to, "chains", "an event chain has no physical time",
+            "an event chain keeps no event log",
+        )  # fmt: skip
         return super().run(
             None, events=chains, observers=observers, progress=progress, checkpoint=checkpoint,
             checkpoint_every=checkpoint_every,

@@ -70,3 +70,23 @@ def test_python_dash_m_discsim_runs():
         [sys.executable, "-m", "discsim", "demo", "--help"], capture_output=True, text=True, check=False
     )
     assert result.returncode == 0 and "--out" in result.stdout
+
+
+def test_ctrl_c_and_errors_a_command_does_not_answer_give_a_line_not_a_traceback(monkeypatch, capsys):
+    """Issue 30, item 13: Ctrl-C outside a command's own handling (a sweep's dask start-up, a table being written)
+    printed a traceback; now one line and exit 130 (and a DiscsimError one line and exit 1)."""
+    from discsim.errors import InvalidArgumentError
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    def refused(args):
+        raise InvalidArgumentError("no such thing")
+
+    for func, code, words in ((interrupted, 130, "discsim demo: interrupted (Ctrl-C)"), (refused, 1, "no such")):
+        parser = cli.build_parser()
+        monkeypatch.setattr(cli, "build_parser", lambda parser=parser: parser)
+        parser._subparsers._group_actions[0].choices["demo"].set_defaults(func=func)
+        assert cli.main(["demo"]) == code
+        err = capsys.readouterr().err
+        assert words in err and "Traceback" not in err

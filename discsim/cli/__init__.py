@@ -33,6 +33,7 @@ from discsim.cli.sweep import SWEEP_FILES
 from discsim.cli.sweep import add_parser as _add_sweep_parser
 from discsim.cli.view import DEFAULT_VIEW_FILE
 from discsim.cli.view import add_parser as _add_view_parser
+from discsim.errors import DiscsimError
 
 __all__ = [
     "DEFAULT_CHECKPOINT_EVERY",
@@ -68,7 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str | PathLike[str]] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``) and return the exit code.
 
-    Exit codes: 0 on success, 1 when the command failed, 2 on a usage error.
+    Exit codes: 0 on success, 1 when the command failed, 2 on a usage error, 130 when interrupted (Ctrl-C).
 
     Example:
         >>> main([])  # no command: prints the help to stderr
@@ -79,4 +80,11 @@ def main(argv: Sequence[str | PathLike[str]] | None = None) -> int:
     if getattr(args, "func", None) is None:
         parser.print_help(sys.stderr)
         return 2
-    return int(args.func(args))
+    try:
+        return int(args.func(args))
+    except KeyboardInterrupt:  # Ctrl-C where a command does not answer it itself (a start-up, a file written)
+        print(f"discsim {args.command}: interrupted (Ctrl-C)", file=sys.stderr)
+        return 130
+    except DiscsimError as exc:  # what a command does not answer itself: a message, never a traceback
+        print(f"discsim {args.command}: {exc}", file=sys.stderr)
+        return 1

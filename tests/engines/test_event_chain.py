@@ -158,6 +158,36 @@ def test_the_structure_of_a_dense_liquid_is_the_event_driven_one():
     assert g_mc.contact_value(sigma) == pytest.approx(g_md.contact_value(sigma), rel=0.02)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_the_lift_log_holds_every_lift_and_changes_nothing(backend, tmp_path):
+    discs, box = ds.random_gas(150, 0.7, seed=4)
+    ell = 3.0 * box.width  # long chains: hundreds of lifts each, past the first batch's room (64): it runs again
+    plain = ds.EventChain(discs, box, seed=6, backend=backend, chain_length=ell).run(chains=3000)
+    logged = ds.EventChain(discs, box, seed=6, backend=backend, chain_length=ell, record_lifts=True)
+    logged.run(chains=1000).run(chains=2000)
+    assert logged.positions.tobytes() == plain.positions.tobytes() and logged.counts == plain.counts
+    lifts = logged.lifts
+    assert len(lifts) == logged.counts["lifts"] > 100 * 3000
+    assert lifts["separation"].sum() == pytest.approx(logged.state().separation, rel=1e-12)
+    assert np.all(np.diff(lifts["chain"]) >= 0) and np.array_equal(lifts["direction"], lifts["chain"] % 2)
+    same = lifts["chain"][1:] == lifts["chain"][:-1]
+    assert np.array_equal(lifts["i"][1:][same], lifts["j"][:-1][same])  # the disc that took over stops next
+    assert np.all((lifts["separation"] > 0) & (lifts["separation"] <= 2.0 * discs.radii.max() + 1e-12))
+    with pytest.raises(ds.InvalidArgumentError, match="record_lifts=True"):
+        _ = plain.lifts
+    path = tmp_path / "ecmc.dsc"
+    logged.save(path)
+    assert ds.load(path).lifts.tobytes() == lifts.tobytes()
+
+
+@needs_numba
+def test_both_backends_log_the_same_lifts():
+    discs, box = ds.random_gas(100, 0.6, seed=2)
+    a, b = (ds.EventChain(discs, box, seed=1, backend=k, record_lifts=True) for k in ("python", "numba"))
+    a.run(chains=500), b.run(chains=500)
+    assert a.lifts.tobytes() == b.lifts.tobytes()
+
+
 @pytest.mark.parametrize(
     ("make", "words"),
     [

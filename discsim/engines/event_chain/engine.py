@@ -25,8 +25,14 @@ from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.model import Box, Discs, _readonly
 from discsim.scene import Scene
 
-__all__ = ["EventChain", "EventChainState"]
+__all__ = ["LIFT_DTYPE", "EventChain", "EventChainState"]
 
+#: A lift of the log (``record_lifts=True``): the chain, its direction (0: +x, 1: +y), the disc that stops (``i``)
+#: and the one that takes the move on (``j``), ``i``'s centre at the contact and the two centres' separation along
+#: the chain.
+LIFT_DTYPE = np.dtype(
+    [("chain", "i8"), ("direction", "i1"), ("i", "i8"), ("j", "i8"), ("x", "f8"), ("y", "f8"), ("separation", "f8")]
+)
 #: Chains drawn per block of the random stream: chain ``k`` starts from block ``k // BLOCK``'s draw, so the
 #: chains are the same however a run is cut into calls (and after a checkpoint).
 BLOCK = 4096
@@ -43,6 +49,7 @@ class EventChainState(EngineState):
             (a disc moved to a cell's edge belongs to the cell it entered).
         chains, lifts, crossings: counts. separation: the sum over the lifts of the two centres' separation
             along the chain (length), the pressure's estimator.
+        lift_log: ``(L,)`` of :data:`LIFT_DTYPE`: every lift so far when the engine records them, else empty.
     """
 
     positions: np.ndarray
@@ -52,6 +59,7 @@ class EventChainState(EngineState):
     lifts: int
     crossings: int
     separation: float
+    lift_log: np.ndarray
 
 
 @register_engine
@@ -73,6 +81,8 @@ class EventChain(Uneditable, Engine):
         chain_length: the displacement of each chain (length; default half the box's shorter side).
         seed: the seed of the random starts (None: one drawn from the operating system, kept in checkpoints).
         backend: ``"auto"`` (numba when it imports), ``"numba"`` or ``"python"``: the same chains bit for bit.
+        record_lifts: keep every lift (:attr:`lifts`: 49 bytes a lift, some hundreds a chain in a dense
+            liquid; in checkpoints too).
 
     Raises:
         InvalidArgumentError: a walled box, a chain length that is not positive and finite, a bad seed.
@@ -100,6 +110,7 @@ class EventChain(Uneditable, Engine):
         chain_length: float | None = None,
         seed: int | None = None,
         backend: str = "auto",
+        record_lifts: bool = False,
     ):
         if not isinstance(box, Box) or not box.periodic:
             msg = f"EventChain runs in a periodic box only (walls and segments are not supported), got {box!r}"
@@ -118,7 +129,11 @@ class EventChain(Uneditable, Engine):
         elif isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             msg = f"seed must be a non-negative integer or None, got {seed!r}"
             raise InvalidArgumentError(msg)
+        if not isinstance(record_lifts, (bool, np.bool_)):
+            msg = f"record_lifts must be True or False, got {record_lifts!r}"
+            raise InvalidArgumentError(msg)
         settings: dict[str, Any] = {
+            "record_lifts": bool(record_lifts),
             "chain_length": float(chain_length),
             "seed": int(seed),
             "backend": _numba.resolve_backend(backend, ("python", "numba"), "EventChain"),
@@ -127,7 +142,9 @@ class EventChain(Uneditable, Engine):
         positions = box.wrap(np.array(discs.positions, dtype=float))
         nx, ny = self._grid
         cells = flat_cells(positions, nx, ny, box.width / nx, box.height / ny)
-        self._state = EventChainState(positions, np.zeros((len(discs), 2), dtype=np.int64), cells, 0, 0, 0, 0.0)
+        self._state = EventChainState(
+            positions, np.zeros((len(discs), 2), dtype=np.int64), cells, 0, 0, 0, 0.0, np.zeros(0, dtype=LIFT_DTYPE)
+        )
 
     def _configure(self, scene: Scene, settings: dict) -> None:
         super().__init__(scene, record=False)
@@ -135,6 +152,7 @@ class EventChain(Uneditable, Engine):
         self.backend = settings["backend"]
         self.chain_length = settings["chain_length"]
         self.seed = settings["seed"]
+        self.record_lifts = bool(settings.get("record_lifts", False))
         radii = np.asarray(scene.discs.radii, dtype=float)
         self._grid = grid_shape(scene.box, 2.0 * float(radii.max()), max(4 * len(radii), 64))
 
@@ -170,6 +188,18 @@ class EventChain(Uneditable, Engine):
         """``chains``, ``lifts`` (a disc passing the move on) and ``cell_crossings`` so far."""
         s = self._state
         return {"chains": s.chains, "lifts": s.lifts, "cell_crossings": s.crossings}
+
+    @property
+    def lifts(self) -> np.ndarray:
+        """``(L,)`` every lift so far, of :data:`LIFT_DTYPE` (a read-only copy).
+
+        Raises:
+            InvalidArgumentError: if the engine was built without ``record_lifts=True``.
+        """
+        if not self.record_lifts:
+            msg = "lifts needs the lift log: build the EventChain with record_lifts=True"
+            raise InvalidArgumentError(msg)
+        return _readonly(self._state.lift_log.copy())
 
     def compressibility_factor(self) -> float:
         """``beta P A / N`` from the lifts of every chain so far: ``1 + S / (C ell)`` (see the class docstring).
@@ -259,25 +289,51 @@ class EventChain(Uneditable, Engine):
             def ints(a):
                 return [int(v) for v in a]
 
-        x, y = floats(positions[:, 0]), floats(positions[:, 1])
-        ix, iy = ints(s.images[:, 0]), ints(s.images[:, 1])
-        out, iout, cell = floats([s.separation]), ints([0, 0]), ints(cells)
-        run_chains(
-            x, y, floats(self.discs.radii), ix, iy, cell, ints(head), ints(nxt), ints(prv), ints(starts),
-            floats([box.width, box.height, cw, ch, self.chain_length]), ints([nx, ny, s.chains % 2]), out, iout,
-        )  # fmt: skip
+        room = 0
+        if self.record_lifts:  # room for the lifts the chains so far suggest; too little, and the batch runs again
+            per_chain = s.lifts / s.chains if s.chains else 64.0
+            room = max(1024, int(1.25 * per_chain * count) + 64)
+        while True:
+            x, y = floats(positions[:, 0]), floats(positions[:, 1])
+            ix, iy = ints(s.images[:, 0]), ints(s.images[:, 1])
+            out, iout, cell = floats([s.separation]), ints([0, 0, 0]), ints(cells)
+            log = (ints(np.zeros(room)), ints(np.zeros(room)), ints(np.zeros(room)), floats(np.zeros(room)),
+                   floats(np.zeros(room)), floats(np.zeros(room)))  # fmt: skip
+            run_chains(
+                x, y, floats(self.discs.radii), ix, iy, cell, ints(head), ints(nxt), ints(prv), ints(starts),
+                floats([box.width, box.height, cw, ch, self.chain_length]), ints([nx, ny, s.chains % 2, s.chains]),
+                out, iout, *log,
+            )  # fmt: skip
+            if int(iout[2]) <= room or not self.record_lifts:
+                break
+            room = int(iout[2])  # the same chains again (the state is untouched), with room for every lift
+        lift_log = s.lift_log
+        if self.record_lifts:
+            new = np.zeros(int(iout[2]), dtype=LIFT_DTYPE)
+            k = len(new)
+            for name, column in zip(("chain", "i", "j", "x", "y", "separation"), log):
+                new[name] = np.asarray(column)[:k]
+            new["direction"] = new["chain"] % 2
+            lift_log = np.concatenate([lift_log, new])
         self._state = EventChainState(
             np.column_stack([np.asarray(x, dtype=float), np.asarray(y, dtype=float)]),
             np.column_stack([np.asarray(ix, dtype=np.int64), np.asarray(iy, dtype=np.int64)]),
             np.asarray(cell, dtype=np.int64), s.chains + count, s.lifts + int(iout[0]),
-            s.crossings + int(iout[1]), float(out[0]),
+            s.crossings + int(iout[1]), float(out[0]), lift_log,
         )  # fmt: skip
 
     # --- the checkpoint's protocol ------------------------------------------------------------------
     def state(self) -> EventChainState:
         s = self._state
         return EventChainState(
-            s.positions.copy(), s.images.copy(), s.cells.copy(), s.chains, s.lifts, s.crossings, s.separation
+            s.positions.copy(),
+            s.images.copy(),
+            s.cells.copy(),
+            s.chains,
+            s.lifts,
+            s.crossings,
+            s.separation,
+            s.lift_log.copy(),
         )
 
     def _settings(self) -> dict:
@@ -301,5 +357,6 @@ class EventChain(Uneditable, Engine):
             np.asarray(state.positions, dtype=float), np.asarray(state.images, dtype=np.int64), cells,
             int(state.chains),
             int(state.lifts), int(state.crossings), float(state.separation),
+            np.asarray(state.lift_log).astype(LIFT_DTYPE),
         )  # fmt: skip
         return sim

@@ -17,7 +17,10 @@ Data (per disc ``i``): ``x, y`` (in the box), ``r``, images ``ix, iy``, ``cell``
 (per cell), ``nxt``, ``prv`` (doubly linked). ``starts``: the first disc of each chain. ``par`` (floats): width,
 height, cell width, cell height, ``ell``. ``ipar`` (ints): nx, ny, ``dir0``. ``out`` (floats): the running sum over
 the lifts of the separation of the two discs along the chain's direction (the pressure's estimator).
-``iout`` (ints): lifts, crossings.
+``iout`` (ints): lifts, crossings, lifts logged. The lift log (when its arrays have room: ``len(lc)``): per lift,
+the chain's number ``lc`` (``ipar[3]`` is the first's), the discs ``li`` (stopping) and ``lj`` (taking over),
+``li``'s centre at the contact ``lx, ly`` and the separation ``lq``; lifts past the room are counted in
+``iout[2]``, not written, so that the caller can run the same chains again with room for all.
 """
 
 from __future__ import annotations
@@ -92,7 +95,7 @@ def ahead(i, along_x, x, y, r, cell, head, nxt, par, ipar):
     return best, partner, sep
 
 
-def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, iout):
+def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, iout, lc, li, lj, lx, ly, lq):
     """Run one chain from each disc of ``starts``; see the module's docstring. Returns the chains run."""
     cw = par[2]
     ch = par[3]
@@ -102,6 +105,9 @@ def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, io
     dir0 = ipar[2]
     lifts = 0
     crossings = 0
+    room = len(lc)
+    logged = iout[2]
+    first = ipar[3]
     total = out[0]  # the running sum goes on lift by lift, however the chains are cut into calls
     for k in range(len(starts)):
         i = starts[k]
@@ -126,6 +132,14 @@ def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, io
                 remaining -= s
                 total += q
                 lifts += 1
+                if logged < room:
+                    lc[logged] = first + k
+                    li[logged] = i
+                    lj[logged] = j
+                    lx[logged] = x[i]
+                    ly[logged] = y[i]
+                    lq[logged] = q
+                logged += 1
                 i = j
             elif edge <= remaining:  # to the cell's edge, into the next cell
                 remaining -= edge
@@ -157,6 +171,7 @@ def run_chains(x, y, r, ix, iy, cell, head, nxt, prv, starts, par, ipar, out, io
     out[0] = total
     iout[0] += lifts
     iout[1] += crossings
+    iout[2] = logged
     return len(starts)
 
 

@@ -7,6 +7,18 @@ import sys
 from pathlib import Path
 
 
+def _argument(text: str, convert, accept, expected: str):
+    """``convert(text)`` when ``accept(value, text)`` holds, else argparse's error naming ``expected``."""
+    try:
+        value = convert(text)
+    except ValueError:
+        value = None
+    if value is None or not accept(value, text):
+        msg = f"expected {expected}, got {text!r}"
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
 def positive_int(text: str) -> int:
     """An argument type: a positive integer written as one (``"12"``, ``"+12"``; not ``"1.5"`` nor ``"0"``).
 
@@ -14,14 +26,7 @@ def positive_int(text: str) -> int:
         >>> positive_int("12")
         12
     """
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1 or str(value) != text.strip().lstrip("+"):
-        msg = f"expected a positive integer, got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return value
+    return _argument(text, int, lambda v, t: v >= 1 and str(v) == t.strip().lstrip("+"), "a positive integer")
 
 
 def positive_float(text: str) -> float:
@@ -31,14 +36,7 @@ def positive_float(text: str) -> float:
         >>> positive_float("0.5")
         0.5
     """
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not value > 0 or value == float("inf"):
-        msg = f"expected a positive finite number, got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return value
+    return _argument(text, float, lambda v, t: 0 < v < float("inf"), "a positive finite number")
 
 
 def non_negative_int(text: str) -> int:
@@ -48,14 +46,7 @@ def non_negative_int(text: str) -> int:
         >>> non_negative_int("0")
         0
     """
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
-        msg = f"expected an integer, 0 or more, got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return value
+    return _argument(text, int, lambda v, t: v >= 0, "an integer, 0 or more")
 
 
 def non_negative_float(text: str) -> float:
@@ -65,14 +56,7 @@ def non_negative_float(text: str) -> float:
         >>> non_negative_float("0")
         0.0
     """
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not value >= 0 or value == float("inf"):
-        msg = f"expected a finite number, 0 or more, got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return value
+    return _argument(text, float, lambda v, t: 0 <= v < float("inf"), "a finite number, 0 or more")
 
 
 def make_output_folder(command: str, out: Path) -> bool:

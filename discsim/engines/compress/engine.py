@@ -221,7 +221,7 @@ class Compression(Uneditable, Engine):
     def report(self) -> CompressionReport:
         """A :class:`CompressionReport` of the compression so far (``reason`` ``"running"`` until it stops)."""
         s = self._state
-        shrink = shrink_factor(self.positions, s.radii, self.box)
+        shrink = self._shrink()
         radii = s.radii * shrink
         history = np.zeros(len(s.history), dtype=HISTORY)
         for k, name in enumerate(HISTORY.names or ()):
@@ -243,11 +243,19 @@ class Compression(Uneditable, Engine):
             history=history,
         )
 
+    def _shrink(self) -> float:
+        """The final shrink of the radii now (:func:`.epoch.shrink_factor`), worked out once per state."""
+        s = self._state
+        cached = getattr(self, "_shrink_cache", None)
+        if cached is None or cached[0] is not s:
+            cached = self._shrink_cache = (s, shrink_factor(self.positions, s.radii, self.box))
+        return cached[1]
+
     def snapshot(self) -> Discs:
         """The discs now, valid for ``EventDriven``: radii shrunk past any contact roundoff left a hair inside
         (by the report's ``shrink``), velocities at ``kT`` (same masses and groups)."""
         s, d = self._state, self.discs
-        radii = s.radii * shrink_factor(self.positions, s.radii, self.box)
+        radii = s.radii * self._shrink()
         return Discs(self.positions, self.velocities, radii, d.masses, d.groups)
 
     # --- the driver's protocol ---------------------------------------------------------------

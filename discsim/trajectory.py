@@ -57,6 +57,8 @@ def reconstruct(
     *,
     unwrapped: bool = False,
     images0=None,
+    gravity=None,
+    masses=None,
 ) -> np.ndarray:
     """Exact positions of every disc at ``times`` from an initial state and a log.
 
@@ -74,6 +76,10 @@ def reconstruct(
             between), those lengths are added back, exactly.
         images0: ``(N, 2)`` whole box lengths each disc had crossed by ``time0`` (``unwrapped`` only;
             :attr:`LastRecords.images`), default none.
+        gravity: the run's ``(gx, gy)`` (None: free flight). Between records a disc of finite mass (``masses``
+            ``(N,)``, default all finite) falls, except after a record that left it at rest: a record of an
+            event with velocity exactly zero (the initial state always falls). A disc that an event stops dead
+            while it still falls (possible only in contrived, exactly symmetric collisions) is taken at rest.
 
     Returns:
         ``(T, N, 2)`` positions. An event exactly at a requested time counts as
@@ -85,19 +91,42 @@ def reconstruct(
     n = len(positions0)
     disc, t_rec, state, starts = _sorted_records(events, positions0, velocities0, time0)
     periodic = box is not None and box.periodic
+    falls = _falling(disc, state, starts, gravity, masses)
     if unwrapped and periodic and (len(state) > n or images0 is not None):
-        state[:, :2] += _image_counts(disc, t_rec, state, starts, box.size, images0) * box.size
+        state[:, :2] += _image_counts(disc, t_rec, state, starts, box.size, images0, gravity, falls) * box.size
     out = np.empty((len(times), n, 2))
     for d in range(n):
         lo, hi = starts[d], starts[d + 1]
         k = lo + np.searchsorted(t_rec[lo:hi], times, side="right") - 1
         k = np.maximum(k, lo)
         dt = (times - t_rec[k])[:, None]
-        x, y, _, _ = advance(state[k, 0], state[k, 1], state[k, 2], state[k, 3], dt[:, 0])
+        x, y = _flight(state[k], dt[:, 0], gravity, None if falls is None else falls[k])
         out[:, d, 0], out[:, d, 1] = x, y
     if periodic and not unwrapped:
         out = box.wrap(out)
     return out
+
+
+def _falling(disc, state, starts, gravity, masses) -> np.ndarray | None:
+    """``(R,)`` bool: the records after which the disc falls (None without gravity; see :func:`reconstruct`)."""
+    if gravity is None or tuple(gravity) == (0.0, 0.0):
+        return None
+    moving = (state[:, 2] != 0.0) | (state[:, 3] != 0.0)
+    moving[starts[:-1]] = True  # the initial state falls
+    if masses is not None:
+        moving &= np.isfinite(np.asarray(masses, dtype=float))[disc]
+    return moving
+
+
+def _flight(state, dt, gravity, falls) -> tuple[np.ndarray, np.ndarray]:
+    """Centres ``dt`` after records ``state`` ``(K, 4)``: free flight, or under ``gravity`` where ``falls``."""
+    x, y, _, _ = advance(state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt)
+    if falls is not None:
+        fx, fy, _, _ = advance(
+            state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt, float(gravity[0]), float(gravity[1])
+        )
+        x, y = np.where(falls, fx, x), np.where(falls, fy, y)
+    return x, y
 
 
 def _sorted_records(events, positions0, velocities0, time0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -262,7 +291,7 @@ class LastRecords:
         return out
 
 
-def _image_counts(disc, t_rec, state, starts, size, images0=None) -> np.ndarray:
+def _image_counts(disc, t_rec, state, starts, size, images0=None, gravity=None, falls=None) -> np.ndarray:
     """``(R, 2)`` whole box lengths (counts, integers as floats) to add to each record so that every disc's
     path is continuous; the shift of a record is ``counts * size``.
 
@@ -271,7 +300,7 @@ def _image_counts(disc, t_rec, state, starts, size, images0=None) -> np.ndarray:
     Each disc starts from ``images0`` ``(N, 2)`` (default zero). The counts are summed as integers, so a
     log read in pieces (:meth:`LastRecords.after`) gives the same shifts, bit for bit, as read whole.
     """
-    x, y, _, _ = advance(state[:-1, 0], state[:-1, 1], state[:-1, 2], state[:-1, 3], t_rec[1:] - t_rec[:-1])
+    x, y = _flight(state[:-1], t_rec[1:] - t_rec[:-1], gravity, None if falls is None else falls[:-1])
     flown = np.column_stack([x, y])
     steps = np.nan_to_num(image_steps(flown, state[1:, :2], size))  # NaN: not there yet, or gone
     first = np.zeros(len(state) + 1, dtype=bool)
@@ -312,7 +341,7 @@ def log_start(events, discs, ids=None) -> tuple[np.ndarray, ...]:
 
 
 def positions_from_log(
-    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None
+    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None, gravity=None
 ):
     """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``.
 
@@ -320,8 +349,10 @@ def positions_from_log(
     column per disc id (:func:`log_start`), NaN where that disc was not in the simulation.
     """
     times = check_times(times, start_time, end_time, span)
-    positions, velocities = log_start(events, discs, ids)[:2]
-    return reconstruct(events, positions, velocities, start_time, times, box, unwrapped=unwrapped)
+    positions, velocities, _, masses, _ = log_start(events, discs, ids)
+    return reconstruct(
+        events, positions, velocities, start_time, times, box, unwrapped=unwrapped, gravity=gravity, masses=masses
+    )
 
 
 def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, velocities: bool = False):

@@ -14,6 +14,12 @@ from discsim import _numba
 #: The backends every engine test runs against (numba ones skip when numba is missing or hidden).
 BACKENDS = ("python", "numba")
 
+if _numba.available():
+    # Import the compiled modules while numba is visible: a test that hides numba (every_backend's "python")
+    # and runs the compiled loop's source interpreted (the laws) would otherwise import them first, as plain
+    # functions, for the whole session.
+    import discsim.engines.event_driven.numba.loop  # noqa: F401
+
 
 @pytest.fixture(params=BACKENDS)
 def every_backend(request, monkeypatch):

@@ -55,3 +55,71 @@ def next_event(positions, velocities, radii, masses, box, exclude=(), segments=(
             if t < best[0]:
                 best = (t, "wall", i, -1)
     return best
+
+
+def _first_downward_root(coefficients, value_at, slope_at, t_min=-1e-12):
+    """The earliest root ``t >= 0`` of a polynomial (``numpy.roots`` order) where it crosses zero downwards;
+    ``inf`` if none. Touching (value <= 0) and approaching now counts as ``t = 0``."""
+    if value_at(0.0) <= 0.0 and slope_at(0.0) < 0.0:
+        return 0.0
+    roots = np.roots(np.trim_zeros(np.asarray(coefficients, dtype=float), "f"))
+    real = np.sort(roots[np.abs(roots.imag) <= 1e-7 * (1.0 + np.abs(roots.real))].real)
+    for t in real:
+        if t > t_min and slope_at(t) < 0.0:
+            # Polish the root by Newton on the polynomial (numpy's roots lose digits near double roots).
+            for _ in range(3):
+                s = slope_at(t)
+                if s != 0.0:
+                    t = t - value_at(t) / s
+            return max(float(t), 0.0)
+    return math.inf
+
+
+def next_event_under_gravity(positions, velocities, radii, masses, box, gravity, resting):
+    """``(dt, kind, i, j)`` of the earliest event under uniform ``gravity``, by brute force over every pair and
+    wall (walled boxes), from the polynomials' coefficients and ``numpy.roots``: independent of the engine's
+    root finders. Discs of infinite mass and discs ``resting`` do not fall."""
+    g = np.asarray(gravity, dtype=float)
+    n = len(radii)
+    accel = np.where((np.isfinite(masses) & ~np.asarray(resting, dtype=bool))[:, None], g, 0.0)
+    best = (math.inf, None, -1, -1)
+    for i in range(n):
+        for j in range(i + 1, n):
+            d = positions[j] - positions[i]
+            w = velocities[j] - velocities[i]
+            a = accel[j] - accel[i]
+            sigma = radii[i] + radii[j]
+            # |d + w t + a t^2 / 2|^2 - sigma^2
+            c4 = a @ a / 4.0
+            c3 = w @ a
+            c2 = w @ w + d @ a
+            c1 = 2.0 * (d @ w)
+            c0 = d @ d - sigma * sigma
+
+            def value(t, c=(c4, c3, c2, c1, c0)):
+                return (((c[0] * t + c[1]) * t + c[2]) * t + c[3]) * t + c[4]
+
+            def slope(t, c=(c4, c3, c2, c1)):
+                return ((4 * c[0] * t + 3 * c[1]) * t + 2 * c[2]) * t + c[3]
+
+            t = _first_downward_root((c4, c3, c2, c1, c0), value, slope)
+            if t < best[0]:
+                best = (t, "collision", i, j)
+    if not box.periodic:
+        for i in range(n):
+            for axis, length in ((0, box.width), (1, box.height)):
+                for wall, sign in ((radii[i], -1.0), (length - radii[i], 1.0)):
+                    # sign * (x + v t + a t^2 / 2 - wall) rises through 0: the disc reaches the wall
+                    x, v, acc = positions[i, axis], velocities[i, axis], accel[i, axis]
+                    coeffs = (-sign * acc / 2.0, -sign * v, -sign * (x - wall))
+
+                    def value(t, c=coeffs):
+                        return (c[0] * t + c[1]) * t + c[2]
+
+                    def slope(t, c=coeffs):
+                        return 2 * c[0] * t + c[1]
+
+                    t = _first_downward_root(coeffs, value, slope)
+                    if t < best[0]:
+                        best = (t, "wall", i, -1)
+    return best

@@ -93,7 +93,13 @@ class EventRecord:
             span="simulated span",
             unwrapped=unwrapped,
             ids=ids,
+            gravity=self._gravity(),
         )
+
+    def _gravity(self):
+        """The run's gravity ``(gx, gy)``, or None (engines without laws, or none)."""
+        laws = getattr(self, "laws", None)
+        return laws.gravity if laws is not None and laws.falls else None
 
     def _refuse_if_streamed(self, what: str) -> None:
         stream = self.run_context.stream

@@ -14,7 +14,7 @@ from __future__ import annotations
 from discsim import model
 from discsim._compiled import compile_from_source, interpret, jit
 from discsim._numba import numba
-from discsim.physics import dynamics, laws
+from discsim.physics import dynamics, laws, roots
 from discsim.physics.sources import boundaries, pairs
 
 __all__ = [
@@ -46,6 +46,8 @@ LAWS = ("collide", "reflect", "closest_point_on_segment", "reflect_off_segment")
 #: Every part, callees before callers.
 _SOURCES = (
     model.minimum_image_1d,
+    *roots.PARTS,
+    dynamics._falling_segment_time,
     *(getattr(dynamics, name) for name in DYNAMICS),
     *(getattr(laws, name) for name in LAWS),
     pairs.predict,

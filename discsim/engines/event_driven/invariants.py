@@ -34,7 +34,9 @@ def check(sim) -> None:
     # Shapes, finiteness, each disc in exactly one cell and listed there, one event per owner, partners
     # in range: what a loaded state must satisfy too.
     state.check(n, len(grid))
-    pos = box.wrap(state.positions_at(state.time))
+    laws = sim.laws
+    falls = np.isfinite(sim.discs.masses) & (state.resting == 0)
+    pos = box.wrap(state.positions_at(state.time, laws.gravity if laws.falls else None, falls))
     expected = grid.cells_of(pos)
     tol = 1e-9 * max(grid.lx, grid.ly)
     for i in np.flatnonzero(expected != state.cell).tolist():  # only allowed on a cell boundary, within roundoff

@@ -65,6 +65,13 @@ class Backend(Protocol):
     def counts(self) -> dict[str, int]:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
 
+    @property
+    def dissipated(self) -> float:
+        """Kinetic energy lost since the start (restitution, rest; 0 under the default laws)."""
+
+    def resting(self) -> np.ndarray:
+        """``(N,)`` bool: the discs at rest under gravity (caller's numbering)."""
+
     def disc_counts(self) -> np.ndarray:
         """``(N,)`` int64: each disc's collision counter (its collisions, wall hits and edits so far; obstacles'
         stay put), a new array in the caller's numbering. O(N): the jam guard's, once per suspected jam."""

@@ -262,6 +262,14 @@ class RunStops:
     def _jam_message(self, discs: np.ndarray, events: int, moved: float, scale: float) -> str:
         listed = discs.tolist()
         named = ", ".join(map(str, listed[:20])) + (f", ... ({len(listed)} discs)" if len(listed) > 20 else "")
+        laws = getattr(self, "laws", None)
+        if laws is not None and not laws.default and laws.restitution != 1.0 and laws.tc == 0.0:
+            return (
+                f"discs {named} collapsed at time {self.time!r}: with restitution {laws.restitution!r} they made "
+                f"{events} collisions and wall hits while the clock moved by {moved:.3g} (inelastic collapse: "
+                "infinitely many collisions in a finite time); set tc= (the TC model: a collision within tc of a "
+                "disc's previous one is elastic) to prevent it"
+            )
         if moved == 0.0:
             return (
                 f"discs {named} are jammed at time {self.time!r}: wedged against each other or a wall, they made "

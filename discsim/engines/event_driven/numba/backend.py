@@ -15,9 +15,11 @@ import numpy as np
 
 from discsim._interrupt import deferred_interrupt
 from discsim.cells import CellGrid
+from discsim.engines.event_driven.numba.reads import CompiledReads
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EVENT_DTYPE, EventKind, EventLog
+from discsim.laws import Laws
 from discsim.physics import dynamics
 from discsim.scene import Scene
 
@@ -40,7 +42,14 @@ def _loop():
     return loop
 
 
-class NumbaBackend:
+def _variants():
+    """The builders of the loop over other physics (:mod:`~discsim.engines.event_driven.numba.variants`)."""
+    from discsim.engines.event_driven.numba import variants
+
+    return variants
+
+
+class NumbaBackend(CompiledReads):
     """The event loop compiled by numba, behind :class:`~discsim.engines.event_driven.protocol.Backend`.
 
     Args:
@@ -51,34 +60,61 @@ class NumbaBackend:
             order as every Python queue.
         law_of_motion, collision_law: other physics for the loop (modules with the functions of
             :mod:`discsim.physics.dynamics` and :mod:`discsim.physics.laws`; None: free flight and the elastic
-            law), compiled into it by :func:`~discsim.engines.event_driven.numba.loop.with_physics`. No engine
+            law), compiled into it by :func:`~discsim.engines.event_driven.numba.variants.with_physics`. No engine
             passes them yet: ``docs/adding-physics.md`` shows a test that does.
         interpreted: run the same loop in the interpreter, compiled by nothing (``name`` is then
             ``"python"``): how the pure-Python backend runs a law of motion or a collision law its own loop
-            does not inline; it needs no numba, and gives the compiled loop's events bit for bit.
+            does not inline, or laws other than the defaults; it needs no numba, and gives the compiled loop's
+            events bit for bit.
+        laws: gravity, restitution, the TC time and the rest speed (:class:`~discsim.laws.Laws`; None: the
+            defaults), numbers the loop reads at run time (one compiled loop serves every value).
     """
 
     name = "numba"
 
     def __init__(
-        self, scene: Scene, grid: CellGrid, queue: str, law_of_motion=None, collision_law=None, *, interpreted=False
+        self,
+        scene: Scene,
+        grid: CellGrid,
+        queue: str,
+        law_of_motion=None,
+        collision_law=None,
+        *,
+        interpreted=False,
+        laws: Laws | None = None,
     ):
         self.scene = scene
+        self.laws = laws or Laws()
         self.box = scene.box
         self.grid = grid
         self.queue_kind = queue
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
         self._lp = _loop()
         self._law_of_motion = law_of_motion or dynamics
-        if law_of_motion is not None or collision_law is not None or interpreted:
-            self._lp = SimpleNamespace(**self._lp.with_physics(law_of_motion, collision_law, interpreted=interpreted))
+        if not self.laws.default:  # the loop that reads the laws (one for every value of them)
+            if law_of_motion is not None or collision_law is not None:
+                msg = "a law of motion or collision law of one's own runs with the default laws only"
+                raise NotImplementedError(msg)
+            self._lp = SimpleNamespace(**_variants().with_laws(interpreted=interpreted))
+        elif law_of_motion is not None or collision_law is not None or interpreted:
+            variants = _variants()
+            self._lp = SimpleNamespace(**variants.with_physics(law_of_motion, collision_law, interpreted=interpreted))
         if interpreted:
             self.name = "python"
         box = self.box
         nx, ny = grid.nx, grid.ny
         # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides
-        # and the box's height (one array: a compiled call passes each array as seven words).
-        self._edges = np.concatenate([np.arange(nx) * grid.lx, [box.width], np.arange(ny) * grid.ly, [box.height]])
+        # and the box's height, then the laws' numbers (one array: a compiled call passes each array as seven
+        # words, and a call of more than 30 arguments cannot be inlined: CPython passes them as a tuple).
+        self._edges = np.concatenate(
+            [
+                np.arange(nx) * grid.lx,
+                [box.width],
+                np.arange(ny) * grid.ly,
+                [box.height],
+                self.laws.array(scene.discs.radii),
+            ]
+        )
         segments = scene.segments
         if segments:
             self._seg = np.array([[*s.p0.tolist(), *s.p1.tolist()] for s in segments], dtype=np.float64)
@@ -167,10 +203,16 @@ class NumbaBackend:
         floats[lp.F_OVERLAP] = state.max_overlap
         floats[lp.F_TIME] = state.time
         floats[lp.F_LTIME] = state.last_time
+        floats[lp.F_LOST] = state.dissipated
+        ints[lp.I_RESTS] = state.rests
+        self._rest = state.resting[order].astype(np.int8)
+        self._tlast = state.last_collision[order].astype(np.float64)
         scene = self.scene
-        self._filtering = bool(scene.filtering)
-        self._group = scene.group[order].astype(np.int64) if self._filtering else np.zeros(1, dtype=np.int64)
-        self._blocked = np.asarray(scene.blocked, dtype=np.bool_) if self._filtering else np.zeros((1, 1), np.bool_)
+        self._egroup = scene.group[order].astype(np.int64) if len(scene) else np.zeros(1, dtype=np.int64)
+        self._etab = self.laws.table(np.unique(scene.discs.groups))
+        filtering = bool(scene.filtering)  # no groups: the loop filters nothing
+        self._group = scene.group[order].astype(np.int64) if filtering else np.zeros(0, dtype=np.int64)
+        self._blocked = np.asarray(scene.blocked, dtype=np.bool_) if filtering else np.zeros((1, 1), np.bool_)
 
     def export(self) -> EventDrivenState:
         """The run state, in the caller's numbering (new arrays)."""
@@ -230,6 +272,10 @@ class NumbaBackend:
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.where(kinds == _COLLISION, others, 0)], others),
             queue_stamp=self._qs[owners].copy(),
+            resting=caller(self._rest),
+            last_collision=caller(self._tlast),
+            dissipated=float(floats[lp.F_LOST]),
+            rests=int(ints[lp.I_RESTS]),
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
@@ -287,8 +333,14 @@ class NumbaBackend:
         k = int(np.flatnonzero(self._order == i)[0])
         t = self.time - float(self._floats[lp.F_EPOCH])
         if position is None:
+            falls = self.laws.falls and rec[k, 6] != np.inf and self._rest[k] == 0
             x, y, _, _ = self._law_of_motion.advance(
-                float(rec[k, 0]), float(rec[k, 1]), float(rec[k, 2]), float(rec[k, 3]), t - float(rec[k, 4])
+                float(rec[k, 0]),
+                float(rec[k, 1]),
+                float(rec[k, 2]),
+                float(rec[k, 3]),
+                t - float(rec[k, 4]),
+                *(self.laws.gravity if falls else (0.0, 0.0)),
             )
             cell = int(self._cell[k])
         else:
@@ -296,128 +348,13 @@ class NumbaBackend:
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
         lp.set_disc(k, x, y, float(vx), float(vy), cell, t, *self._predict_args())
 
-    # --- cheap reads -----------------------------------------------------------------------
-    @property
-    def time(self) -> float:
-        return float(self._floats[self._lp.F_TIME])
-
-    @time.setter
-    def time(self, value: float) -> None:
-        self._floats[self._lp.F_TIME] = value
-
-    @property
-    def max_overlap(self) -> float:
-        return float(self._floats[self._lp.F_OVERLAP])
-
-    @max_overlap.setter
-    def max_overlap(self, value: float) -> None:
-        self._floats[self._lp.F_OVERLAP] = value
-
-    @property
-    def max_queue(self) -> int:
-        return int(self._ints[self._lp.I_MAXQ])
-
-    @property
-    def virial(self) -> float:
-        """Sum over collisions of ``dp_i . (r_i - r_j)`` since the start (for the pressure)."""
-        return float(self._floats[self._lp.F_VIRIAL])
-
-    def counts(self) -> dict[str, int]:
-        """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
-        lp, ints = self._lp, self._ints
-        return {
-            "collisions": int(ints[lp.I_COLL]),
-            "wall_hits": int(ints[lp.I_WALL]),
-            "cell_crossings": int(ints[lp.I_CROSS]),
-            "stale": int(ints[lp.I_STALE]),
-            "predictions": int(ints[lp.I_PRED]),
-        }
-
-    def disc_counts(self) -> np.ndarray:
-        """``(N,)`` each disc's collision counter, in the caller's numbering (a new array)."""
-        out = np.empty(len(self._order), dtype=np.int64)
-        out[self._order] = self._count
-        return out
-
-    def positions(self) -> np.ndarray:
-        """``(N, 2)`` centres at ``time``, not wrapped."""
-        t = self.time - float(self._floats[self._lp.F_EPOCH])
-        rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
-        x, y, _, _ = self._law_of_motion.advance(rx, ry, vx, vy, t - tr)
-        return np.column_stack([x, y]).reshape(-1, 2)
-
-    def unwrapped_positions(self) -> np.ndarray:
-        """``(N, 2)`` centres at ``time``, each disc followed across the periodic edges."""
-        images = self._images[self._rank()].astype(np.float64)
-        return self.positions() + images * np.array([self.box.width, self.box.height])
-
-    def velocities(self) -> np.ndarray:
-        """``(N, 2)`` velocities at ``time``."""
-        t = self.time - float(self._floats[self._lp.F_EPOCH])
-        rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
-        _, _, vx, vy = self._law_of_motion.advance(rx, ry, vx, vy, t - tr)
-        return np.column_stack([vx, vy]).reshape(-1, 2)
-
-    def last_event(self) -> tuple[float, int, int, int] | None:
-        """``(time, kind, i, j)`` of the last physical event in the caller's numbering, or None."""
-        lp, ints = self._lp, self._ints
-        if ints[lp.I_LKIND] < 0:
-            return None
-        i, j = int(ints[lp.I_LI]), int(ints[lp.I_LJ])
-        order = self._order
-        return float(self._floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if j >= 0 else j
-
-    def _rank(self) -> np.ndarray:
-        """Internal number of each caller's disc, ``(N,)`` (built when asked: O(N), as every read that needs it)."""
-        rank = np.empty_like(self._order)
-        rank[self._order] = np.arange(len(self._order))
-        return rank
-
-    def nbytes(self) -> int:
-        """Bytes of the run state's arrays (per disc, per cell and the queue; not the log buffer)."""
-        arrays = (
-            self._rec, self._count, self._images, self._kept_partner, self._kept_stamp, self._cell,
-            self._head, self._nxt, self._qk, self._qo, self._qs,
-            self._qt, self._bheap, self._bht, self._bpos, self._barg, self._order, self._group,
-        )  # fmt: skip
-        return sum(a.nbytes for a in arrays)
-
-    def queue_size(self) -> int:
-        """Events pending now (at most N)."""
-        return int(self._ints[self._lp.I_SIZE])
-
-    def queue_storage(self) -> int:
-        """Entries the queue holds: one slot per pending event (no dead entries)."""
-        return self.queue_size()
-
-    def _check(self) -> None:
-        """Assert the backend's own invariants (each block's earliest event, the heap of blocks, linked cells); O(N)."""
-        qt, n = self._qt, len(self._order)
-        assert np.isinf(qt[n:]).all() and np.count_nonzero(qt != np.inf) == self.queue_size(), "queue size out of date"
-        blocks = qt.reshape(-1, self._lp.BLOCK)
-        first = blocks.min(axis=1)
-        assert np.array_equal(self._bht[self._bpos], first), "a block's time out of date"
-        earliest = np.argmax(blocks == first[:, None], axis=1) + np.arange(len(blocks)) * self._lp.BLOCK
-        finite = first != np.inf
-        assert np.array_equal(self._barg[finite], earliest[finite]), "a block's earliest disc out of date"
-        heap, times = self._bheap, self._bht
-        assert np.array_equal(heap[self._bpos], np.arange(len(heap))), "heap positions out of date"
-        parent = (np.arange(1, len(heap)) - 1) >> 1
-        pt, ct, po, co = times[parent], times[1:], heap[parent], heap[1:]
-        ordered = (pt < ct) | ((pt == ct) & (po < co))
-        assert ordered.all(), "heap order broken"
-        members = np.zeros(len(self._order), dtype=np.int64)
-        sizes = np.zeros(len(self.grid), dtype=np.int64)
-        self._lp.unlink(self._head, self._nxt, members, sizes)
-        assert np.array_equal(np.repeat(np.arange(len(sizes)), sizes), self._cell[members]), "cells out of date"
-
     # --- argument lists of the compiled functions --------------------------------------------
     def _geometry(self) -> tuple:
         grid, box = self.grid, self.box
         return (grid.nx, grid.ny, bool(box.periodic), self._edges)
 
     def _filter(self) -> tuple:
-        return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)
+        return (self._seg, self._seg_start, self._seg_idx, self._group, self._blocked, self._rest)
 
     def _queue(self) -> tuple:
         return (self._qt, self._bheap, self._bht, self._bpos, self._barg, self._qk, self._qo, self._qs, self._ints)
@@ -432,7 +369,7 @@ class NumbaBackend:
         return (
             self._rec, self._count, self._order, self._images, self._kept_partner, self._kept_stamp,
             self._cell, self._head, self._nxt,
-            *self._geometry(), *self._filter(), *self._queue(), self._floats,
+            *self._geometry(), *self._filter(), *self._queue(), self._floats, self._etab, self._egroup, self._tlast,
         )  # fmt: skip
 
 

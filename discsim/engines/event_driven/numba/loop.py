@@ -30,9 +30,13 @@ import math
 import numpy as np
 
 from discsim._compiled import inline, jit, prefetch
+from discsim.engines.event_driven.numba import blocks
+from discsim.engines.event_driven.numba.blocks import BLOCK, BLOCK_SHIFT, discard, push, reblock  # noqa: F401
 from discsim.events import EventKind
+from discsim.laws import GX, GY, PER_GROUP, REST_SPEED, TC, E
 from discsim.physics.compiled import (
     advance,
+    closest_point_on_segment,
     cross,
     pair_predict,
     pair_resolve,
@@ -43,7 +47,6 @@ from discsim.physics.compiled import (
     segment_time_of_impact,
 )
 from discsim.physics.sources.boundaries import MINUS_X, MINUS_Y, PLUS_X, PLUS_Y
-from discsim.queue import sift_down, sift_up
 
 INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT = (
@@ -52,112 +55,38 @@ COLLISION, WALL, CROSSING, SEGMENT = (
 # Columns of a disc's row in ``rec``.
 X, Y, VX, VY, T, R, M, KEPT = 0, 1, 2, 3, 4, 5, 6, 7
 # Slots of ``ints``.
-I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ = range(11)
-N_INTS = 11
+I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS = range(12)
+N_INTS = 12
+if I_SIZE != blocks.I_SIZE:  # the queue (blocks.py) counts its events in the same slot
+    raise ImportError("blocks.I_SIZE is not the loop's I_SIZE")
 # Slots of ``floats``.
-F_EPOCH, F_VIRIAL, F_OVERLAP, F_TIME, F_LTIME = range(5)
-N_FLOATS = 5
+F_EPOCH, F_VIRIAL, F_OVERLAP, F_TIME, F_LTIME, F_LOST = range(6)
+N_FLOATS = 6
+#: Whether the loop reads the laws (gravity, restitution, the TC model, rest; :class:`~discsim.laws.Laws`): a
+#: constant, so that this module's loop, the one every run of the default laws takes, compiles no branch of
+#: theirs (reading them at run time cost 15% at N = 10^3 and 10^4); :func:`with_laws` compiles the loop again
+#: with it True, cached under its own names.
+LAWS = False
 # Why run_events returned: the queue holds nothing before ``until`` or the event limit was met; the
 # budget of pops or the log buffer ran out (call again); the crossing budget was spent.
 DONE, MORE, CROSSINGS = 0, 1, 2
 
 
-# --- the queue: each disc's pending time, and a binary heap of blocks of discs ----------------------------
-# ``qt[owner]`` is the owner's pending time (inf: none). The discs are cut into blocks of ``BLOCK`` consecutive
-# numbers; ``barg[b]`` is block b's earliest owner (the lowest number among equal times) and the heap orders the
-# blocks by that owner's ``(time, owner)``: ``bheap[k]`` is the block at position k, ``bht[k]`` its time and
-# ``bpos[b]`` its position. Blocks hold consecutive numbers, so ordering equal times by block orders them by
-# owner: the heap pops the earliest ``(time, owner)``, as every queue of the Python backend. A heap of owners
-# moved (and re-indexed) a random owner per level, about twenty levels at N = 10^6, each a cache miss (a quarter
-# of the loop's time there); a disc's new time here rescans its block (16 times in a row, with selects: which is
-# earlier is a coin toss) and sifts a heap 16 times smaller, which stays in cache. Blocks of 16 against the heap
-# of owners: 1.17x at N = 10^6, 1.12x at 10^4 (blocks of 8 and 32 did less).
-BLOCK_SHIFT = 4
-BLOCK = 1 << BLOCK_SHIFT
-_sift_up = jit(sift_up)
-_sift_down = jit(sift_down)
-
-
-@jit
-def _earliest(b, qt):
-    """Block ``b``'s earliest ``(time, owner)``: the lowest owner among equal times (inf and the block's first
-    owner when it has no event)."""
-    base = b << BLOCK_SHIFT
-    best = qt[base]
-    owner = base
-    for o in range(base + 1, base + BLOCK):
-        t = qt[o]
-        owner = o if t < best else owner
-        best = t if t < best else best
-    return best, owner
-
-
-@jit
-def _moved(b, t, owner, bheap, bht, bpos, barg):
-    """Block ``b``'s earliest event is now ``owner``'s at ``t``: restore the heap."""
-    k = bpos[b]
-    old = bht[k]
-    bht[k] = t
-    barg[b] = owner
-    if t < old:
-        _sift_up(k, bheap, bht, bpos)
-    elif t > old:
-        _sift_down(k, bheap.shape[0], bheap, bht, bpos)
-
-
-@inline
-def push(owner, t, kind, other, stamp, qt, bheap, bht, bpos, barg, qk, qo, qs, ints):
-    """Schedule ``owner``'s event at ``t`` (finite), replacing its pending one.
-
-    The loop leaves a popped event in place until its owner is predicted again, so that the new
-    event replaces it with one update instead of a removal and an insertion.
-    """
-    qk[owner] = kind
-    qo[owner] = other
-    qs[owner] = stamp
-    if qt[owner] == INF:
-        ints[I_SIZE] += 1
-    qt[owner] = t
-    b = owner >> BLOCK_SHIFT
-    first = bht[bpos[b]]
-    if t < first or (t == first and owner < barg[b]):
-        _moved(b, t, owner, bheap, bht, bpos, barg)
-    elif barg[b] == owner:  # the block's earliest event moved later: find the new earliest
-        first, o = _earliest(b, qt)
-        _moved(b, first, o, bheap, bht, bpos, barg)
-
-
-@jit
-def discard(owner, qt, bheap, bht, bpos, barg, ints):
-    """Drop ``owner``'s pending event, if any."""
-    if qt[owner] != INF:
-        qt[owner] = INF
-        ints[I_SIZE] -= 1
-        b = owner >> BLOCK_SHIFT
-        if barg[b] == owner:
-            first, o = _earliest(b, qt)
-            _moved(b, first, o, bheap, bht, bpos, barg)
-
-
-@jit
-def reblock(qt, bheap, bht, bpos, barg):
-    """Find every block's earliest event and build the heap of blocks (at the start, and after every time moved)."""
-    n_blocks = bheap.shape[0]
-    for b in range(n_blocks):
-        bheap[b] = b
-        bpos[b] = b
-        bht[b], barg[b] = _earliest(b, qt)
-    for k in range((n_blocks >> 1) - 1, -1, -1):
-        _sift_down(k, n_blocks, bheap, bht, bpos)
-
-
 # --- prediction ----------------------------------------------------------------------------------------
+@inline
+def accel(k, gravity, gx, gy, rec, rest):
+    """Disc ``k``'s acceleration: gravity, unless there is none, ``k`` is an obstacle or it is at rest."""
+    if gravity and rec[k, M] != INF and rest[k] == 0:
+        return gx, gy
+    return 0.0, 0.0
+
+
 @inline
 def predict(
     i, t, exclude, direction,
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
+    seg, seg_start, seg_idx, group, blocked, rest,
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
 ):  # fmt: skip
     """Schedule disc ``i``'s earliest event after ``t``, as the Python backend's ``predict`` does.
@@ -171,7 +100,12 @@ def predict(
     width = edges[nx]
     height = edges[nx + 1 + ny]
     ri = rec[i, R]
-    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
+    gx = gy = 0.0
+    if LAWS:  # a constant: the loop of the default laws compiles none of this (see with_laws)
+        gx, gy = edges[nx + ny + 2 + GX], edges[nx + ny + 2 + GY]
+    gravity = LAWS and (gx != 0.0 or gy != 0.0)
+    axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
     c = cell[i]
     cx = c // ny
     cy = c - cx * ny
@@ -180,6 +114,7 @@ def predict(
     after_crossing = direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i])
     best = INF
     new_partner = -1
+    filtering = group.shape[0] != 0  # the filter's groups, or none (nothing passes through anything)
     gi = group[i] if filtering else 0
     for ddx in range(-1, 2):
         if after_crossing and ((direction == PLUS_X and ddx != 1) or (direction == MINUS_X and ddx != -1)):
@@ -218,9 +153,13 @@ def predict(
                 if j == i or j == exclude or (filtering and blocked[gi, group[j]]):
                     j = nxt[j]
                     continue
+                axj = ayj = 0.0
+                if gravity:
+                    axj, ayj = accel(j, gravity, gx, gy, rec, rest)
                 tij = pair_predict(
-                    rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], rec[j, R], offx, offy, vxi, vyi, ri
-                )
+                    rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], rec[j, R], offx, offy, vxi, vyi, ri,
+                    axj, ayj, axj - axi, ayj - ayi,
+                )  # fmt: skip
                 if tij < best:
                     best = tij
                     new_partner = j
@@ -243,17 +182,17 @@ def predict(
     # 2. The next wall, segment or cell boundary.
     walled = not periodic
     best, kind, other = predict_x(
-        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1
+        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1, axi
     )
     ty, kind_y, other_y = predict_y(
-        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1
+        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1, ayi
     )
     if ty < best:
         best, kind, other = ty, kind_y, other_y
     for m in range(seg_start[c], seg_start[c + 1]):
         k = seg_idx[m]
         if k != -2 - exclude:  # not the segment just left
-            ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3])
+            ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi)
             if ts < best:
                 best, kind, other = ts, SEGMENT, k
     if best < 0.0:
@@ -268,11 +207,24 @@ def predict(
         push(i, t_best, kind, other, 0, qt, bheap, bht, bpos, barg, qk, qo, qs, ints)
 
 
+@inline
+def restitution(i, j, now, law, etab, egroup, tlast):
+    """The coefficient of restitution of a collision of ``i`` and ``j`` (``i`` twice: a wall) at time ``now``:
+    one number or the pair of groups' (:class:`~discsim.laws.Laws`), 1 within the TC time of either's last."""
+    e = law[E]
+    if law[PER_GROUP] != 0.0:
+        e = etab[egroup[i], egroup[j]]
+    tc = law[TC]
+    if tc > 0.0 and (now - tlast[i] < tc or now - tlast[j] < tc):
+        e = 1.0
+    return e
+
+
 @jit
 def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
+    seg, seg_start, seg_idx, group, blocked, rest,
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
 ):  # fmt: skip
     """The start of a run: predict every moving disc at time 0, in internal order."""
@@ -281,7 +233,7 @@ def predict_all(
             predict(
                 i, 0.0, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
     ints[I_MAXQ] = ints[I_SIZE]
@@ -292,7 +244,7 @@ def set_disc(
     i, x, y, vx, vy, new_cell, t,
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
+    seg, seg_start, seg_idx, group, blocked, rest,
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
 ):  # fmt: skip
     """Restart disc ``i``'s path at ``t`` from ``(x, y)`` with ``(vx, vy)`` (in cell ``new_cell``), as the Python
@@ -307,11 +259,12 @@ def set_disc(
     rec[i, VX] = vx
     rec[i, VY] = vy
     rec[i, T] = t
+    rest[i] = 0  # an edited disc falls again
     count[i] += 1
     predict(
         i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
         nx, ny, periodic, edges,
-        seg, seg_start, seg_idx, filtering, group, blocked,
+        seg, seg_start, seg_idx, group, blocked, rest,
         qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
     )  # fmt: skip
     if ints[I_SIZE] > ints[I_MAXQ]:
@@ -423,8 +376,8 @@ def run_events(
     until, limit, crossings, budget, rebase_every, recording,
     rec, count, order, images, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
-    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats,
+    seg, seg_start, seg_idx, group, blocked, rest,
+    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats, etab, egroup, tlast,
     ev_t, ev_kind, ev_i, ev_j, ev_f,
 ):  # fmt: skip
     """Process events with times <= ``until``: the Python backend's ``process_events``, compiled.
@@ -438,6 +391,11 @@ def run_events(
     """
     width = edges[nx]
     height = edges[nx + 1 + ny]
+    law = edges[nx + ny + 2 :]  # the laws' numbers follow the cells' edges
+    gx = gy = 0.0
+    if LAWS:
+        gx, gy = law[GX], law[GY]
+    gravity = LAWS and (gx != 0.0 or gy != 0.0)
     n_coll = n_wall = n_cross = n_stale = 0
     done = 0
     logged = 0
@@ -488,16 +446,51 @@ def run_events(
                 predict(
                     i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, periodic, edges,
-                    seg, seg_start, seg_idx, filtering, group, blocked,
+                    seg, seg_start, seg_idx, group, blocked, rest,
                     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
                 )  # fmt: skip
                 continue
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
-            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T])
             mi, mj = rec[i, M], rec[j, M]
+            axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+            axj, ayj = accel(j, gravity, gx, gy, rec, rest)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
+            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], axj, ayj)
+            e = restitution(i, j, t + epoch, law, etab, egroup, tlast) if LAWS else 1.0
             dx, dy, uxi, uyi, uxj, uyj = pair_resolve(
-                xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic
+                xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic, e
             )
+            moved_j = mj != INF  # obstacles never move, and their counter never changes
+            i_falls = gravity and rest[i] == 0  # (owners are never obstacles)
+            if gravity and i_falls != (moved_j and rest[j] == 0):
+                # One falls onto a support (an obstacle or a disc at rest): too slow a bounce and it rests there.
+                if not i_falls:  # i supports j: the normal points from i to j
+                    bounce = -e * ((vxj - vxi) * dx + (vyj - vyi) * dy)
+                    up = -(gx * dx + gy * dy)
+                else:
+                    bounce = -e * ((vxi - vxj) * -dx + (vyi - vyj) * -dy)
+                    up = gx * dx + gy * dy
+                norm = math.sqrt(dx * dx + dy * dy)
+                if up > 0.0 and bounce < law[REST_SPEED] * norm:
+                    if not i_falls:
+                        uxi, uyi, uxj, uyj = vxi, vyi, 0.0, 0.0
+                        rest[j] = 1
+                    else:
+                        uxi, uyi, uxj, uyj = 0.0, 0.0, vxj, vyj
+                        rest[i] = 1
+                    ints[I_RESTS] += 1
+                else:  # hit hard enough: a support at rest wakes (an obstacle stays)
+                    rest[i] = 0
+                    if moved_j:
+                        rest[j] = 0
+            if LAWS and (e != 1.0 or gravity):
+                lost = 0.5 * mi * ((vxi * vxi + vyi * vyi) - (uxi * uxi + uyi * uyi))
+                if moved_j:
+                    lost += 0.5 * mj * ((vxj * vxj + vyj * vyj) - (uxj * uxj + uyj * uyj))
+                floats[F_LOST] += lost
+            if LAWS and law[TC] > 0.0:
+                tlast[i] = t + epoch
+                if moved_j:
+                    tlast[j] = t + epoch
             overlap = 1.0 - math.sqrt(dx * dx + dy * dy) / (rec[i, R] + rec[j, R])
             if overlap > max_overlap:
                 max_overlap = overlap
@@ -516,33 +509,58 @@ def run_events(
                 ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, uxi, uyi
                 ev_f[logged, 4], ev_f[logged, 5], ev_f[logged, 6], ev_f[logged, 7] = xj, yj, uxj, uyj
                 logged += 1
+            # The pair cannot meet again before one of them changes course, unless one falls and the other
+            # does not (a ball bouncing on a disc at rest comes back): then neither is excluded.
+            alike = not gravity or (rest[i] == 0) == (moved_j and rest[j] == 0)
             predict(
-                i, t, j, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                i, t, j if alike else -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
-            if mj != INF:  # obstacles never move, and their counter never changes
+            if moved_j:
                 count[j] += 1
                 predict(
-                    j, t, i, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                    j, t, i if alike else -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, periodic, edges,
-                    seg, seg_start, seg_idx, filtering, group, blocked,
+                    seg, seg_start, seg_idx, group, blocked, rest,
                     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
                 )  # fmt: skip
                 if ints[I_SIZE] > max_queue:
                     max_queue = ints[I_SIZE]
             last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j
         elif kind == WALL or kind == SEGMENT:
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
+            axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
+            e = restitution(i, i, t + epoch, law, etab, egroup, tlast) if LAWS else 1.0
+            wx, wy = vxi, vyi
             if kind == SEGMENT:
                 vxi, vyi = reflect_off_segment(
-                    xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
+                    xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], e
                 )
-                exclude = -2 - other  # never the same segment again straight away
+                # never the same segment again straight away (a falling disc may come back: not excluded)
+                exclude = -1 if gravity else -2 - other
             else:
-                vxi, vyi = reflect(vxi, vyi, other)
+                vxi, vyi = reflect(vxi, vyi, other, e)
                 exclude = -1
+            if gravity:  # too slow a bounce off a floor (a support with gravity into it): the disc rests
+                if kind == SEGMENT:
+                    sx0, sy0, sx1, sy1 = seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
+                    qx, qy = closest_point_on_segment(xi, yi, sx0, sy0, sx1, sy1)
+                    nxw, nyw = xi - qx, yi - qy
+                elif other == 0:
+                    nxw, nyw = (1.0 if xi < 0.5 * width else -1.0), 0.0
+                else:
+                    nxw, nyw = 0.0, (1.0 if yi < 0.5 * height else -1.0)
+                norm = math.sqrt(nxw * nxw + nyw * nyw)
+                if gx * nxw + gy * nyw < 0.0 and vxi * nxw + vyi * nyw < law[REST_SPEED] * norm:
+                    vxi = vyi = 0.0
+                    rest[i] = 1
+                    ints[I_RESTS] += 1
+            if LAWS and (e != 1.0 or gravity):
+                floats[F_LOST] += 0.5 * rec[i, M] * ((wx * wx + wy * wy) - (vxi * vxi + vyi * vyi))
+            if LAWS and law[TC] > 0.0:
+                tlast[i] = t + epoch
             rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, vxi, vyi, t
             count[i] += 1
             n_wall += 1
@@ -558,7 +576,7 @@ def run_events(
             predict(
                 i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
@@ -579,7 +597,7 @@ def run_events(
             predict(
                 i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             if n_cross == crossings:
@@ -610,69 +628,6 @@ def run_events(
     return done, n_cross, logged, why
 
 
-# --- the loop over other physics -----------------------------------------------------------------------
 #: The functions above that call the physics parts (directly or through ``predict``), callees first: the ones
-#: :func:`with_physics` compiles anew.
+#: :mod:`~discsim.engines.event_driven.numba.variants` compiles anew.
 PHYSICAL = ("predict", "predict_all", "set_disc", "run_events")
-#: Loops compiled by :func:`with_physics`, by the identity of their laws (kept here, so the ids stay theirs).
-_BUILT: dict[tuple[int, int, bool], tuple[object, object, dict]] = {}
-
-
-def with_physics(law_of_motion=None, collision_law=None, *, interpreted: bool = False) -> dict:
-    """This loop compiled over another law of motion or collision law: nothing above is edited.
-
-    The parts (:func:`discsim.physics.compiled.compile_parts`) are compiled over the given laws, and the
-    functions of :data:`PHYSICAL` are compiled anew from their very source with those parts in place of free
-    flight and the elastic law; the rest (queue, cells, prefetches) is shared. The new functions are compiled
-    in this process, once per pair of laws, and not cached on disk (numba's cache knows a function by its own
-    source file and name, not by the laws compiled into it): the first use takes about as long as the first
-    compile of this module.
-
-    ``interpreted=True`` (or no numba) rebuilds the same functions over the laws without compiling them: the
-    very loop, run by the interpreter on its arrays, as the pure-Python backend runs a law that its own loop
-    does not inline (about 5x slower than that loop on free flight; the same events, bit for bit, as the
-    compiled loop over the same laws). The prefetches, which only a compiled loop can ask for, do nothing.
-
-    Args:
-        law_of_motion: a module with the functions of :data:`discsim.physics.compiled.DYNAMICS` (None: free
-            flight).
-        collision_law: a module with those of :data:`discsim.physics.compiled.LAWS` (None: elastic).
-        interpreted: build the loop for the interpreter instead of compiling it.
-
-    Returns:
-        This module's namespace (a dict) with the new ``predict``, ``predict_all``, ``set_disc`` and
-        ``run_events``; :class:`~discsim.engines.event_driven.numba.backend.NumbaBackend` runs it as it runs
-        this module.
-    """
-    from types import FunctionType
-
-    from discsim._numba import numba
-    from discsim.physics.compiled import compile_parts
-
-    nb = numba()
-    interpreted = interpreted or nb is None
-    key = (id(law_of_motion), id(collision_law), interpreted)
-    if key in _BUILT:
-        return _BUILT[key][2]
-    namespace = dict(globals())
-    namespace.update(compile_parts(law_of_motion, collision_law, interpreted=interpreted))
-    if interpreted:
-        namespace.update(_prefetch_disc=_no_prefetch, _prefetch_cells=_no_prefetch)
-    for name in PHYSICAL:
-        dispatcher = globals()[name]
-        source = getattr(dispatcher, "py_func", dispatcher)
-        table = dict(source.__globals__)
-        table.update({key: namespace[key] for key in table if key in namespace})
-        rebuilt = FunctionType(source.__code__, table, source.__name__, source.__defaults__)
-        rebuilt.__qualname__ = source.__qualname__
-        if interpreted:
-            namespace[name] = rebuilt
-        else:
-            options = {key: value for key, value in dispatcher.targetoptions.items() if key != "nopython"}
-            namespace[name] = nb.njit(cache=False, **options)(rebuilt)
-    _BUILT[key] = (law_of_motion, collision_law, namespace)
-    return namespace
-
-
-def _no_prefetch(*args) -> None:
-    """The prefetches of an interpreted loop: nothing (the interpreter cannot ask the CPU for a cache line)."""

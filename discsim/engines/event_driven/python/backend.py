@@ -224,6 +224,8 @@ class PythonBackend:
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.maximum(others, 0)], others) if len(kinds) else others,
             queue_stamp=np.array([p[2] for _, _, p in pending], dtype=np.int64),
+            resting=np.zeros(n, dtype=np.int64),  # this loop runs the default laws only (EventDriven's rule)
+            last_collision=np.full(n, -np.inf),
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
@@ -306,6 +308,15 @@ class PythonBackend:
     def counts(self) -> dict[str, int]:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
         return {**self._counts, "predictions": self._predictions()}
+
+    @property
+    def dissipated(self) -> float:
+        """Kinetic energy lost: none (this loop runs the default laws only: elastic, no gravity)."""
+        return 0.0
+
+    def resting(self) -> np.ndarray:
+        """``(N,)`` bool: no disc rests without gravity."""
+        return np.zeros(len(self._count), dtype=bool)
 
     def disc_counts(self) -> np.ndarray:
         """``(N,)`` each disc's collision counter, in the caller's numbering (a new array)."""

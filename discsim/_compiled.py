@@ -21,7 +21,7 @@ __all__ = ["compile_from_source", "inline", "interpret", "jit", "prefetch"]
 
 #: What every compiled function of discsim may compile into itself, besides its own folder's modules (the
 #: physics parts, the minimum image, the queue's heap, the event kinds, this module): paths under the package.
-DEPENDENCIES = ("physics", "model.py", "queue.py", "events.py", "_compiled.py")
+DEPENDENCIES = ("physics", "model.py", "laws.py", "queue.py", "events.py", "_compiled.py")
 _PACKAGE = Path(__file__).resolve().parent
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from discsim import model
 from discsim._compiled import compile_from_source, interpret, jit
 from discsim._numba import numba
-from discsim.physics import dynamics, laws
+from discsim.physics import dynamics, laws, roots
 from discsim.physics.sources import boundaries, pairs
 
 __all__ = [
@@ -43,9 +43,13 @@ __all__ = [
 #: (:mod:`discsim.physics.laws`).
 DYNAMICS = ("advance", "exit_x", "exit_y", "pair_time_of_impact", "segment_time_of_impact")
 LAWS = ("collide", "reflect", "closest_point_on_segment", "reflect_off_segment")
+#: The root finders the law of motion calls under an acceleration (callees first).
+ROOTS = tuple(getattr(roots, name) for name in roots.__all__)
 #: Every part, callees before callers.
 _SOURCES = (
     model.minimum_image_1d,
+    *ROOTS,
+    dynamics._falling_segment_time,
     *(getattr(dynamics, name) for name in DYNAMICS),
     *(getattr(laws, name) for name in LAWS),
     pairs.predict,

@@ -1,8 +1,9 @@
-"""Free flight, the law of motion between events: every loop advances discs and times its events here.
+"""The law of motion between events: free flight under a uniform acceleration (gravity), written once.
 
 A disc's state is its centre ``(x, y)`` and velocity ``(vx, vy)`` at a reference time (the lazy clocks of the
-event-driven engine); between events it moves along ``x + vx t``, ``y + vy t``. Everything derived from that law
-is defined once in this module:
+event-driven engine); between events it moves along ``x + vx t + ax t^2 / 2`` with a constant acceleration
+``(ax, ay)``: gravity for a disc that falls, zero for an obstacle, a disc at rest, or a run without gravity
+(free flight, ``x + vx t``). Everything derived from that law is defined once in this module:
 
 - :func:`advance`: a disc's centre and velocity ``dt`` after its reference time;
 - :func:`exit_x` and :func:`exit_y`: the time to leave a slab ``lo <= x <= hi`` (a wall the disc's edge reaches,
@@ -10,10 +11,12 @@ is defined once in this module:
 - :func:`pair_time_of_impact`: the time two discs come into contact (the relative motion of a pair);
 - :func:`segment_time_of_impact`: the time a disc touches a fixed segment.
 
-A law of motion is a module with these five functions and the same signatures: uniform gravity would bend
-:func:`advance`, :func:`exit_y` and :func:`segment_time_of_impact` into parabolas and keep
-:func:`pair_time_of_impact` (a pair's relative motion stays linear). Each function uses only arithmetic and
-:mod:`math`, so numba compiles it into the compiled loops from this very source.
+Each takes the acceleration last, defaulting to zero: without it (or with zeros) each function is free flight,
+the same operations bit for bit as before gravity. Two discs that both fall keep a linear relative motion, so
+their time of impact is the free-flight one; a falling disc against one that does not fall (or against a
+segment's end point) solves a quartic (:func:`discsim.physics.roots.accelerated_time_of_impact`), and a
+slab's edges quadratics (:func:`discsim.physics.roots.accelerated_exit`). Each function uses only arithmetic
+and :mod:`math`, so numba compiles it into the compiled loops from this very source.
 """
 
 from __future__ import annotations
@@ -31,13 +34,16 @@ INF = math.inf
 Real = TypeVar("Real", float, "np.ndarray")
 
 
-def advance(x: Real, y: Real, vx: Real, vy: Real, dt: Real) -> tuple[Real, Real, Real, Real]:
+def advance(
+    x: Real, y: Real, vx: Real, vy: Real, dt: Real, ax: float = 0.0, ay: float = 0.0
+) -> tuple[Real, Real, Real, Real]:
     """A disc's centre and velocity ``dt`` after a time at which it was at ``(x, y)`` moving at ``(vx, vy)``.
 
     Args:
         x, y: the centre at the reference time (length).
         vx, vy: the velocity at the reference time (length / time).
         dt: time since the reference time (may be negative: back along the path).
+        ax, ay: the disc's constant acceleration (length / time^2; numbers, not arrays); zero: free flight.
 
     Returns:
         ``(x, y, vx, vy)`` at the reference time plus ``dt``.
@@ -45,12 +51,19 @@ def advance(x: Real, y: Real, vx: Real, vy: Real, dt: Real) -> tuple[Real, Real,
     Example:
         >>> advance(1.0, 2.0, 0.5, -1.0, 2.0)
         (2.0, 0.0, 0.5, -1.0)
+        >>> advance(0.0, 10.0, 1.0, 0.0, 2.0, 0.0, -2.0)  # thrown sideways, falling
+        (2.0, 6.0, 1.0, -4.0)
     """
-    return x + vx * dt, y + vy * dt, vx, vy
+    if ax == 0.0 and ay == 0.0:
+        return x + vx * dt, y + vy * dt, vx, vy
+    return x + (vx + 0.5 * ax * dt) * dt, y + (vy + 0.5 * ay * dt) * dt, vx + ax * dt, vy + ay * dt
 
 
-def exit_x(x: float, vx: float, lo: float, hi: float) -> tuple[float, int]:
+def exit_x(x: float, vx: float, lo: float, hi: float, a: float = 0.0) -> tuple[float, int]:
     """Time until a centre at ``x`` moving at ``vx`` reaches ``hi`` (moving up) or ``lo`` (moving down).
+
+    Under an acceleration ``a`` along x, :func:`~discsim.physics.roots.accelerated_exit` answers (a disc
+    may turn back and leave by the side it moved away from).
 
     A wall at ``length`` stops a disc of radius ``r`` when its centre reaches ``length - r`` (``hi``); a cell
     edge, when the centre reaches it. The time is not clamped: a centre already past the line it moves
@@ -66,6 +79,8 @@ def exit_x(x: float, vx: float, lo: float, hi: float) -> tuple[float, int]:
         >>> exit_x(5.0, 0.0, 1.0, 9.0)
         (inf, 0)
     """
+    if a != 0.0:
+        return accelerated_exit(x, vx, a, lo, hi)
     if vx > 0.0:
         return (hi - x) / vx, 1
     if vx < 0.0:
@@ -73,13 +88,15 @@ def exit_x(x: float, vx: float, lo: float, hi: float) -> tuple[float, int]:
     return INF, 0
 
 
-def exit_y(y: float, vy: float, lo: float, hi: float) -> tuple[float, int]:
-    """:func:`exit_x` along y (a separate function: gravity would bend this one only).
+def exit_y(y: float, vy: float, lo: float, hi: float, a: float = 0.0) -> tuple[float, int]:
+    """:func:`exit_x` along y (a separate function: a law that bends one axis only replaces this one).
 
     Example:
         >>> exit_y(5.0, -2.0, 1.0, 9.0)
         (2.0, -1)
     """
+    if a != 0.0:
+        return accelerated_exit(y, vy, a, lo, hi)
     if vy > 0.0:
         return (hi - y) / vy, 1
     if vy < 0.0:
@@ -87,8 +104,14 @@ def exit_y(y: float, vy: float, lo: float, hi: float) -> tuple[float, int]:
     return INF, 0
 
 
-def pair_time_of_impact(dx: float, dy: float, dvx: float, dvy: float, sigma: float) -> float:
+def pair_time_of_impact(
+    dx: float, dy: float, dvx: float, dvy: float, sigma: float, dax: float = 0.0, day: float = 0.0
+) -> float:
     """Time until two discs, now ``(dx, dy)`` apart, come to distance ``sigma``.
+
+    ``(dax, day)`` is the relative acceleration (disc 2's minus disc 1's): zero when both fall or neither
+    does; otherwise the quartic's earliest contact while approaching
+    (:func:`~discsim.physics.roots.accelerated_time_of_impact`).
 
     Solves ``a t^2 + 2 b t + c = 0`` with ``a = |dv|^2``, ``b = dr . dv`` and ``c = |dr|^2 - sigma^2`` by the
     cancellation-free root ``t = c / (-b + sqrt(b^2 - a c))``. Only approaching pairs (``b < 0``) collide; a
@@ -114,6 +137,8 @@ def pair_time_of_impact(dx: float, dy: float, dvx: float, dvy: float, sigma: flo
         >>> pair_time_of_impact(4.0, 0.0, 1.0, 0.0, 2.0)
         inf
     """
+    if dax != 0.0 or day != 0.0:
+        return accelerated_time_of_impact(dx, dy, dvx, dvy, dax, day, sigma)
     b = dx * dvx + dy * dvy
     c = dx * dx + dy * dy - sigma * sigma
     a = dvx * dvx + dvy * dvy
@@ -124,9 +149,10 @@ def pair_time_of_impact(dx: float, dy: float, dvx: float, dvy: float, sigma: flo
 
 
 def segment_time_of_impact(
-    px: float, py: float, vx: float, vy: float, radius: float, ax: float, ay: float, bx: float, by: float
-) -> float:
-    """Time until a moving disc touches the fixed segment from ``a`` to ``b``.
+    px: float, py: float, vx: float, vy: float, radius: float, ax: float, ay: float, bx: float, by: float,
+    gx: float = 0.0, gy: float = 0.0,
+) -> float:  # fmt: skip
+    """Time until a moving disc (acceleration ``(gx, gy)``, default none) touches the fixed segment ``a``-``b``.
 
     The disc (centre ``p``, velocity ``v``, ``radius``) can touch the segment's face, where the contact point
     is the foot of the perpendicular, or one of its end points, which act as discs of radius 0 (the pair time
@@ -142,6 +168,8 @@ def segment_time_of_impact(
         >>> round(segment_time_of_impact(5.0, 0.6, -1.0, 0.0, 1.0, 0.0, -3.0, 0.0, 0.0), 12)  # the end (0, 0)
         4.2
     """
+    if gx != 0.0 or gy != 0.0:
+        return _falling_segment_time(px, py, vx, vy, radius, ax, ay, bx, by, gx, gy)
     ex, ey = bx - ax, by - ay
     length2 = ex * ex + ey * ey
     best = INF
@@ -163,3 +191,48 @@ def segment_time_of_impact(
     if t < best:
         best = t
     return best
+
+
+def _falling_segment_time(
+    px: float, py: float, vx: float, vy: float, radius: float, ax: float, ay: float, bx: float, by: float,
+    gx: float, gy: float,
+) -> float:  # fmt: skip
+    """:func:`segment_time_of_impact` under an acceleration ``(gx, gy)``.
+
+    The face: the centre's signed distance from the line, ``s + vn t + gn t^2 / 2``, comes down to ``radius``
+    (:func:`~discsim.physics.roots.accelerated_exit` of the slab ``[radius, inf)``, which finds a disc that
+    just bounced off the face coming back); the foot of the perpendicular must then lie on the segment. The
+    end points are fixed points: a quartic each. There is no exclusion of the segment just hit: a falling disc
+    may come back to it.
+    """
+    ex, ey = bx - ax, by - ay
+    length2 = ex * ex + ey * ey
+    best = INF
+    length = math.sqrt(length2)
+    nx, ny = -ey / length, ex / length
+    s = (px - ax) * nx + (py - ay) * ny
+    vn = vx * nx + vy * ny
+    gn = gx * nx + gy * ny
+    if s < 0.0:
+        s, vn, gn = -s, -vn, -gn
+    t, side = accelerated_exit(s, vn, gn, radius, INF)
+    if side < 0:
+        if t < 0.0:
+            t = 0.0
+        qx = px + (vx + 0.5 * gx * t) * t
+        qy = py + (vy + 0.5 * gy * t) * t
+        u = ((qx - ax) * ex + (qy - ay) * ey) / length2
+        if 0.0 <= u <= 1.0:
+            best = t
+    t = accelerated_time_of_impact(ax - px, ay - py, -vx, -vy, -gx, -gy, radius)
+    if t < best:
+        best = t
+    t = accelerated_time_of_impact(bx - px, by - py, -vx, -vy, -gx, -gy, radius)
+    if t < best:
+        best = t
+    return best
+
+
+# The roots solve what free flight does not (imported last: they call free flight's own times when the
+# acceleration is zero).
+from discsim.physics.roots import accelerated_exit, accelerated_time_of_impact  # noqa: E402

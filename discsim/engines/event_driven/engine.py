@@ -23,6 +23,7 @@ from discsim.engines.event_driven.state import EventDrivenState
 from discsim.engines.event_driven.stops import RunStops
 from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.events import KIND_NAMES, Event
+from discsim.laws import Laws
 from discsim.model import Box, Discs, _readonly, image_steps
 from discsim.scene import Scene
 
@@ -37,7 +38,7 @@ BACKENDS: dict[str, BackendClass] = {"python": PythonBackend, "numba": NumbaBack
 
 @register_engine
 class EventDriven(RunStops, Engine):
-    """Exact event-driven simulation of elastic hard discs (PIC).
+    """Exact event-driven simulation of hard discs (PIC): elastic by default, or under gravity, with restitution.
 
     Args:
         discs: the discs at ``time = 0``.
@@ -65,6 +66,21 @@ class EventDriven(RunStops, Engine):
             ``pip install "discsim[fast]"``; :mod:`discsim.engines.event_driven.numba`) or
             ``"python"`` (pure Python; :mod:`discsim.engines.event_driven.python`). Both give the
             same events bit for bit and the same checkpoints; ``sim.backend`` names the one that runs.
+            Under laws other than the defaults, ``"python"`` runs the compiled loop's own source in the
+            interpreter (the pure-Python loop knows free flight only), and ``"auto"`` the compiled loop.
+        gravity: ``(gx, gy)``, a uniform acceleration of every disc of finite mass (length / time^2):
+            exact parabolic flight (``docs/laws.md``); None: none. Obstacles and segments stay put; under
+            gravity a disc that bounces off a support slower than ``rest_speed`` comes to rest.
+        restitution: the normal coefficient of restitution ``e`` in [0, 1] of every collision and bounce
+            (1: elastic), or a dict from pairs of group labels to ``e`` (pairs not named are elastic; a
+            bounce off a wall or segment uses the disc's group's pair with itself). The kinetic energy lost
+            is :attr:`dissipated`.
+        tc: the TC model's time (Luding & McNamara 1998): a collision within ``tc`` of either disc's previous
+            collision is elastic, which prevents inelastic collapse; 0: none (a collapse then ends the run
+            with a :class:`~discsim.errors.JammedError` naming the discs).
+        rest_speed: under gravity, the speed below which a bounce off a support ends in rest (velocity zero,
+            gravity off, until hit harder); None: the speed of a bounce ``1e-3`` of the smallest radius high
+            (:class:`~discsim.laws.Laws`).
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
@@ -103,11 +119,16 @@ class EventDriven(RunStops, Engine):
         segments=(),
         pass_through=(),
         backend: str = "auto",
+        gravity=None,
+        restitution=1.0,
+        tc: float = 0.0,
+        rest_speed: float | None = None,
     ):
-        self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend)
+        laws = Laws.build(gravity, restitution, tc, rest_speed)
+        self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend, laws)
         self._backend.start()
 
-    def _configure(self, scene: Scene, record: bool, queue: str, cell_size, backend: str) -> None:
+    def _configure(self, scene: Scene, record: bool, queue: str, cell_size, backend: str, laws: Laws) -> None:
         """Check the options and build the grid and the backend (not yet started or loaded)."""
         if not isinstance(queue, str) or queue not in QUEUES:
             msg = f"queue must be one of {sorted(QUEUES)}, got {queue!r}"
@@ -115,7 +136,9 @@ class EventDriven(RunStops, Engine):
         self._auto = isinstance(backend, str) and backend == "auto"
         #: physical events the Python loop still runs before ``"auto"`` takes the compiled one (None: no switch)
         self._auto_events: int | None = None
-        if self._auto:
+        if self._auto and not laws.default:  # the interpreted loop is slow: the compiled one from the start
+            backend = "numba" if available() else "python"
+        elif self._auto:
             backend, self._auto_events = auto_plan(len(scene))
         else:
             backend = resolve_backend(backend, BACKENDS, "EventDriven")
@@ -123,9 +146,17 @@ class EventDriven(RunStops, Engine):
         grid = self.grid = self.cell_grid(scene.discs.radii, scene.box, cell_size)
         self.queue_kind = queue
         self.cell_size = cell_size
-        self._backend = BACKENDS[backend](scene, grid, queue)
+        self.laws = laws
+        self._backend = self._new_backend(backend, scene, grid)
         if backend == "numba":
             mark_loaded()
+
+    def _new_backend(self, name: str, scene: Scene, grid: CellGrid):
+        """The backend ``name`` over the engine's laws: the default laws run on :data:`BACKENDS`; others on the
+        compiled loop (``"python"``: that loop's source, interpreted)."""
+        if self.laws.default:
+            return BACKENDS[name](scene, grid, self.queue_kind)
+        return NumbaBackend(scene, grid, self.queue_kind, interpreted=name == "python", laws=self.laws)
 
     @staticmethod
     def cell_grid(radii: np.ndarray, box: Box, cell_size: float | None = None) -> CellGrid:
@@ -162,13 +193,15 @@ class EventDriven(RunStops, Engine):
             "cell_size": self.cell_size,
             "backend": "auto" if self._auto else self.backend,  # "auto" chooses again when loaded
             "edits": self._edits,
+            **({} if self.laws.default else {"laws": self.laws.settings()}),
         }
 
     @classmethod
     def _restore(cls, scene, settings, state, events, start_time) -> EventDriven:
         sim = cls.__new__(cls)
+        laws = Laws.from_settings(settings.get("laws", {}))
         sim._configure(
-            scene, settings["record"], settings["queue"], settings["cell_size"], settings.get("backend", "auto")
+            scene, settings["record"], settings["queue"], settings["cell_size"], settings.get("backend", "auto"), laws
         )
         if (state.grid_nx, state.grid_ny) != (sim.grid.nx, sim.grid.ny):
             msg = (
@@ -217,12 +250,15 @@ class EventDriven(RunStops, Engine):
         backend's ``last_event()``, when the discs keep their numbers) as the last event."""
         old, box = self._backend, self.box
         grid = self.cell_grid(scene.discs.radii, box, self.cell_size)  # may refuse the new discs: nothing changed
-        backend = BACKENDS[old.name](scene, grid, self.queue_kind)
+        backend = self._new_backend(old.name, scene, grid)
         state = fresh_state(scene, grid)
         state.time = state.epoch = old.time
         for name, value in old.counts().items():
             setattr(state, name, value)
         state.virial, state.max_overlap, state.max_queue = old.virial, old.max_overlap, old.max_queue
+        if not self.laws.default:  # what the laws keep: the energy lost, and which kept discs are at rest
+            state.dissipated = old.dissipated
+            state.resting[: len(keep)] = old.resting()[keep]
         if last is not None:
             state.last_time, state.last_kind, state.last_i, state.last_j = last
         if box.periodic and len(keep):
@@ -242,7 +278,7 @@ class EventDriven(RunStops, Engine):
         if not available():
             return
         old = self._backend
-        compiled = BACKENDS["numba"](self.scene, self.grid, self.queue_kind)
+        compiled = self._new_backend("numba", self.scene, self.grid)
         compiled.load(old.export())
         self._backend = compiled
         mark_loaded()
@@ -311,6 +347,36 @@ class EventDriven(RunStops, Engine):
         """
         return self._backend.queue_storage()
 
+    @property
+    def dissipated(self) -> float:
+        """Kinetic energy lost since the start: by collisions with restitution below 1, and by discs coming to
+        rest under gravity (0 for elastic discs)."""
+        return self._backend.dissipated if not self.laws.default else 0.0
+
+    @property
+    def resting(self) -> np.ndarray:
+        """``(N,)`` bool: the discs at rest now (under gravity: velocity zero, gravity off; a fresh copy)."""
+        if self.laws.default:
+            return np.zeros(len(self.discs), dtype=bool)
+        return self._backend.resting()
+
+    def potential_energy(self) -> float:
+        """The potential energy in the gravity field, ``-sum(m g . r)`` over the discs of finite mass (zero at the
+        origin of the box; 0 without gravity). In a periodic box ``r`` is the unwrapped centre (a disc that falls
+        through the floor and comes in at the top keeps falling: its energy stays its own). Units: mass
+        length^2 / time^2."""
+        if not self.laws.falls:
+            return 0.0
+        masses = self.discs.masses
+        finite = np.isfinite(masses)
+        g = np.array(self.laws.gravity)
+        return float(-np.sum(masses[finite] * (self._backend.unwrapped_positions()[finite] @ g)))
+
+    def energy(self) -> float:
+        """Kinetic plus potential energy: conserved exactly when collisions are elastic (``restitution=1``)
+        and no disc comes to rest; it falls by :attr:`dissipated` otherwise."""
+        return self.kinetic_energy() + self.potential_energy()
+
     def pressure(self) -> float:
         """Pressure from the collision virial, averaged since the start.
 
@@ -322,6 +388,12 @@ class EventDriven(RunStops, Engine):
         elapsed = self.time - self.start_time
         if elapsed <= 0:
             msg = "pressure() needs a run of positive duration"
+            raise InvalidArgumentError(msg)
+        if self.laws.falls:
+            msg = (
+                f"pressure() is the bulk pressure of a uniform gas; under gravity {self.laws.gravity} the "
+                "pressure varies with height (measure the density profile instead)"
+            )
             raise InvalidArgumentError(msg)
         return (self.kinetic_energy() + self._backend.virial / (2.0 * elapsed)) / self.box.area
 

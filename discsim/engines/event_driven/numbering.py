@@ -85,4 +85,6 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
         queue_kind=empty_queue,
         queue_other=empty_queue,
         queue_stamp=empty_queue,
+        resting=np.zeros(n, dtype=np.int64),
+        last_collision=np.full(n, -math.inf),
     )

@@ -19,7 +19,8 @@ __all__ = ["EventDrivenState"]
 
 @dataclass(eq=False)
 class EventDrivenState(EngineState):
-    """Everything an event-driven run needs to continue bit for bit (version 1).
+    """Everything an event-driven run needs to continue bit for bit (version 2: version 1 plus the laws' fields,
+    which a version-1 state, from before the laws, reads as their defaults).
 
     Per-disc arrays are indexed in the caller's numbering (as ``discs``); disc
     indices inside arrays (partners, cell members, queue owners) too. Times in
@@ -53,9 +54,15 @@ class EventDrivenState(EngineState):
             the pending events, one per owner: kind (:class:`~discsim.events.EventKind`),
             the partner (collision), wall axis, crossing direction or segment, and
             the partner's counter (collisions only).
+        resting ``(N,)`` int64: 1 for a disc at rest under gravity (velocity zero, gravity off).
+        last_collision ``(N,)``: each disc's last collision time (absolute; ``-inf`` if none or unrecorded),
+            kept for the TC model only.
+
+    Scalars of the laws: dissipated (kinetic energy lost in collisions and by discs coming to rest),
+    rests (discs put to rest).
     """
 
-    VERSION = 1
+    VERSION = 2
 
     time: float
     epoch: float
@@ -91,6 +98,27 @@ class EventDrivenState(EngineState):
     queue_kind: np.ndarray
     queue_other: np.ndarray
     queue_stamp: np.ndarray
+    resting: np.ndarray = None  # type: ignore[assignment]  # None: none at rest (filled in by __post_init__)
+    last_collision: np.ndarray = None  # type: ignore[assignment]  # None: no collision recorded
+    dissipated: float = 0.0
+    rests: int = 0
+
+    def __post_init__(self) -> None:
+        n = len(self.order)
+        if self.resting is None:
+            self.resting = np.zeros(n, dtype=np.int64)
+        if self.last_collision is None:
+            self.last_collision = np.full(n, -np.inf)
+
+    @classmethod
+    def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int):
+        """As :meth:`EngineState.from_arrays`; a version-1 state (before the laws) gets their defaults."""
+        if version == 1:
+            n = len(arrays.get("order", ()))
+            arrays = {**arrays, "resting": np.zeros(n, dtype=np.int64), "last_collision": np.full(n, -np.inf)}
+            scalars = {**scalars, "dissipated": 0.0, "rests": 0}
+            version = cls.VERSION
+        return super().from_arrays(scalars, arrays, version)
 
     def check(self, n: int, n_cells: int) -> None:
         """Refuse a state that cannot belong to ``n`` discs on a grid of ``n_cells`` cells.
@@ -119,6 +147,8 @@ class EventDrivenState(EngineState):
             "kept_partner": ((n,), "i"),
             "kept_stamp": ((n,), "i"),
             "order": ((n,), "i"),
+            "resting": ((n,), "i"),
+            "last_collision": ((n,), "f"),
         }
         q = np.shape(self.queue_owner)
         shapes.update(
@@ -176,9 +206,19 @@ class EventDrivenState(EngineState):
             "predictions": self.predictions,
         }
 
-    def positions_at(self, time: float) -> np.ndarray:
-        """``(N, 2)`` centres at ``time`` (absolute), not wrapped."""
+    def positions_at(self, time: float, gravity=None, falls: np.ndarray | None = None) -> np.ndarray:
+        """``(N, 2)`` centres at ``time`` (absolute), not wrapped.
+
+        Args:
+            gravity: the run's ``(gx, gy)`` (None: none).
+            falls: ``(N,)`` bool, the discs that fall (finite mass and not at rest); None: all that are not at
+                rest.
+        """
         t = time - self.epoch
         (x0, y0), (vx, vy) = self.ref_positions.T, self.velocities.T
         x, y, _, _ = advance(x0, y0, vx, vy, t - self.ref_times)
+        if gravity is not None and tuple(gravity) != (0.0, 0.0):
+            falls = self.resting == 0 if falls is None else falls
+            fx, fy, _, _ = advance(x0, y0, vx, vy, t - self.ref_times, float(gravity[0]), float(gravity[1]))
+            x, y = np.where(falls, fx, x), np.where(falls, fy, y)
         return np.column_stack([x, y]).reshape(-1, 2)

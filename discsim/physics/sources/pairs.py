@@ -17,6 +17,7 @@ __all__ = ["predict", "resolve"]
 def predict(
     xj: float, yj: float, vxj: float, vyj: float, dtj: float, rj: float,
     offx: float, offy: float, vxi: float, vyi: float, ri: float,
+    axj: float = 0.0, ayj: float = 0.0, dax: float = 0.0, day: float = 0.0,
 ) -> float:  # fmt: skip
     """Time from now until disc ``j`` meets disc ``i``, or ``inf``.
 
@@ -30,17 +31,19 @@ def predict(
         rj, ri: the radii.
         offx, offy: image shift of ``j``'s cell minus ``i``'s centre now (length).
         vxi, vyi: disc ``i``'s velocity now.
+        axj, ayj: disc ``j``'s acceleration (gravity if it falls; default none).
+        dax, day: ``j``'s acceleration minus ``i``'s (zero when both fall or neither does).
     """
-    xj, yj, vxj, vyj = advance(xj, yj, vxj, vyj, dtj)
-    return pair_time_of_impact(xj + offx, yj + offy, vxj - vxi, vyj - vyi, ri + rj)
+    xj, yj, vxj, vyj = advance(xj, yj, vxj, vyj, dtj, axj, ayj)
+    return pair_time_of_impact(xj + offx, yj + offy, vxj - vxi, vyj - vyi, ri + rj, dax, day)
 
 
 def resolve(
     xi: float, yi: float, vxi: float, vyi: float, mi: float,
     xj: float, yj: float, vxj: float, vyj: float, mj: float,
-    width: float, height: float, periodic: bool,
+    width: float, height: float, periodic: bool, e: float = 1.0,
 ) -> tuple[float, float, float, float, float, float]:  # fmt: skip
-    """The collision of discs ``i`` and ``j``, both at contact now.
+    """The collision of discs ``i`` and ``j``, both at contact now, with restitution ``e`` (default elastic).
 
     Returns:
         ``(dx, dy, uxi, uyi, uxj, uyj)``: the line of centres (``j`` minus ``i``, minimum image in a periodic
@@ -54,5 +57,5 @@ def resolve(
     if periodic:
         dx = minimum_image_1d(dx, width)
         dy = minimum_image_1d(dy, height)
-    uxi, uyi, uxj, uyj = collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+    uxi, uyi, uxj, uyj = collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj, e)
     return dx, dy, uxi, uyi, uxj, uyj

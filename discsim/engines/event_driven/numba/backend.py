@@ -18,6 +18,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.events import EVENT_DTYPE, EventKind, EventLog
+from discsim.laws import Laws
 from discsim.physics import dynamics
 from discsim.scene import Scene
 
@@ -55,15 +56,27 @@ class NumbaBackend:
             passes them yet: ``docs/adding-physics.md`` shows a test that does.
         interpreted: run the same loop in the interpreter, compiled by nothing (``name`` is then
             ``"python"``): how the pure-Python backend runs a law of motion or a collision law its own loop
-            does not inline; it needs no numba, and gives the compiled loop's events bit for bit.
+            does not inline, or laws other than the defaults; it needs no numba, and gives the compiled loop's
+            events bit for bit.
+        laws: gravity, restitution, the TC time and the rest speed (:class:`~discsim.laws.Laws`; None: the
+            defaults), numbers the loop reads at run time (one compiled loop serves every value).
     """
 
     name = "numba"
 
     def __init__(
-        self, scene: Scene, grid: CellGrid, queue: str, law_of_motion=None, collision_law=None, *, interpreted=False
+        self,
+        scene: Scene,
+        grid: CellGrid,
+        queue: str,
+        law_of_motion=None,
+        collision_law=None,
+        *,
+        interpreted=False,
+        laws: Laws | None = None,
     ):
         self.scene = scene
+        self.laws = laws or Laws()
         self.box = scene.box
         self.grid = grid
         self.queue_kind = queue
@@ -77,8 +90,17 @@ class NumbaBackend:
         box = self.box
         nx, ny = grid.nx, grid.ny
         # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides
-        # and the box's height (one array: a compiled call passes each array as seven words).
-        self._edges = np.concatenate([np.arange(nx) * grid.lx, [box.width], np.arange(ny) * grid.ly, [box.height]])
+        # and the box's height, then the laws' numbers (one array: a compiled call passes each array as seven
+        # words, and a call of more than 30 arguments cannot be inlined: CPython passes them as a tuple).
+        self._edges = np.concatenate(
+            [
+                np.arange(nx) * grid.lx,
+                [box.width],
+                np.arange(ny) * grid.ly,
+                [box.height],
+                self.laws.array(scene.discs.radii),
+            ]
+        )
         segments = scene.segments
         if segments:
             self._seg = np.array([[*s.p0.tolist(), *s.p1.tolist()] for s in segments], dtype=np.float64)
@@ -167,10 +189,16 @@ class NumbaBackend:
         floats[lp.F_OVERLAP] = state.max_overlap
         floats[lp.F_TIME] = state.time
         floats[lp.F_LTIME] = state.last_time
+        floats[lp.F_LOST] = state.dissipated
+        ints[lp.I_RESTS] = state.rests
+        self._rest = state.resting[order].astype(np.int8)
+        self._tlast = state.last_collision[order].astype(np.float64)
         scene = self.scene
-        self._filtering = bool(scene.filtering)
-        self._group = scene.group[order].astype(np.int64) if self._filtering else np.zeros(1, dtype=np.int64)
-        self._blocked = np.asarray(scene.blocked, dtype=np.bool_) if self._filtering else np.zeros((1, 1), np.bool_)
+        self._egroup = scene.group[order].astype(np.int64) if len(scene) else np.zeros(1, dtype=np.int64)
+        self._etab = self.laws.table(np.unique(scene.discs.groups))
+        filtering = bool(scene.filtering)  # no groups: the loop filters nothing
+        self._group = scene.group[order].astype(np.int64) if filtering else np.zeros(0, dtype=np.int64)
+        self._blocked = np.asarray(scene.blocked, dtype=np.bool_) if filtering else np.zeros((1, 1), np.bool_)
 
     def export(self) -> EventDrivenState:
         """The run state, in the caller's numbering (new arrays)."""
@@ -230,6 +258,10 @@ class NumbaBackend:
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.where(kinds == _COLLISION, others, 0)], others),
             queue_stamp=self._qs[owners].copy(),
+            resting=caller(self._rest),
+            last_collision=caller(self._tlast),
+            dissipated=float(floats[lp.F_LOST]),
+            rests=int(ints[lp.I_RESTS]),
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
@@ -287,8 +319,10 @@ class NumbaBackend:
         k = int(np.flatnonzero(self._order == i)[0])
         t = self.time - float(self._floats[lp.F_EPOCH])
         if position is None:
+            falls = self.laws.falls and rec[k, 6] != np.inf and self._rest[k] == 0
             x, y, _, _ = self._law_of_motion.advance(
-                float(rec[k, 0]), float(rec[k, 1]), float(rec[k, 2]), float(rec[k, 3]), t - float(rec[k, 4])
+                float(rec[k, 0]), float(rec[k, 1]), float(rec[k, 2]), float(rec[k, 3]), t - float(rec[k, 4]),
+                *(self.laws.gravity if falls else (0.0, 0.0)),
             )
             cell = int(self._cell[k])
         else:
@@ -323,15 +357,28 @@ class NumbaBackend:
         return float(self._floats[self._lp.F_VIRIAL])
 
     def counts(self) -> dict[str, int]:
-        """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions``."""
+        """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions`` (and ``rests``, discs
+        put to rest, under gravity)."""
         lp, ints = self._lp, self._ints
-        return {
+        counts = {
             "collisions": int(ints[lp.I_COLL]),
             "wall_hits": int(ints[lp.I_WALL]),
             "cell_crossings": int(ints[lp.I_CROSS]),
             "stale": int(ints[lp.I_STALE]),
             "predictions": int(ints[lp.I_PRED]),
         }
+        if self.laws.falls:
+            counts["rests"] = int(ints[lp.I_RESTS])
+        return counts
+
+    @property
+    def dissipated(self) -> float:
+        """Kinetic energy lost in collisions (restitution) and by discs coming to rest, since the start."""
+        return float(self._floats[self._lp.F_LOST])
+
+    def resting(self) -> np.ndarray:
+        """``(N,)`` bool: the discs at rest (under gravity), in the caller's numbering."""
+        return self._rest[self._rank()].astype(bool)
 
     def disc_counts(self) -> np.ndarray:
         """``(N,)`` each disc's collision counter, in the caller's numbering (a new array)."""
@@ -341,10 +388,22 @@ class NumbaBackend:
 
     def positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, not wrapped."""
-        t = self.time - float(self._floats[self._lp.F_EPOCH])
-        rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
-        x, y, _, _ = self._law_of_motion.advance(rx, ry, vx, vy, t - tr)
+        x, y, _, _ = self._now()
         return np.column_stack([x, y]).reshape(-1, 2)
+
+    def _now(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every disc's ``(x, y, vx, vy)`` at ``time``, in the caller's numbering (the discs that fall under
+        gravity advanced with it)."""
+        t = self.time - float(self._floats[self._lp.F_EPOCH])
+        rank = self._rank()
+        rx, ry, vx, vy, tr = self._rec[rank, :5].T
+        advance = self._law_of_motion.advance
+        x, y, vx, vy = advance(rx, ry, vx, vy, t - tr)
+        if self.laws.falls:
+            falls = (self._rec[rank, 6] != np.inf) & (self._rest[rank] == 0)
+            fx, fy, fvx, fvy = advance(rx, ry, self._rec[rank, 2], self._rec[rank, 3], t - tr, *self.laws.gravity)
+            x, y, vx, vy = (np.where(falls, f, v) for f, v in ((fx, x), (fy, y), (fvx, vx), (fvy, vy)))
+        return x, y, vx, vy
 
     def unwrapped_positions(self) -> np.ndarray:
         """``(N, 2)`` centres at ``time``, each disc followed across the periodic edges."""
@@ -353,9 +412,7 @@ class NumbaBackend:
 
     def velocities(self) -> np.ndarray:
         """``(N, 2)`` velocities at ``time``."""
-        t = self.time - float(self._floats[self._lp.F_EPOCH])
-        rx, ry, vx, vy, tr = self._rec[self._rank(), :5].T
-        _, _, vx, vy = self._law_of_motion.advance(rx, ry, vx, vy, t - tr)
+        _, _, vx, vy = self._now()
         return np.column_stack([vx, vy]).reshape(-1, 2)
 
     def last_event(self) -> tuple[float, int, int, int] | None:
@@ -379,6 +436,7 @@ class NumbaBackend:
             self._rec, self._count, self._images, self._kept_partner, self._kept_stamp, self._cell,
             self._head, self._nxt, self._qk, self._qo, self._qs,
             self._qt, self._bheap, self._bht, self._bpos, self._barg, self._order, self._group,
+            self._rest, self._tlast, self._egroup,
         )  # fmt: skip
         return sum(a.nbytes for a in arrays)
 
@@ -417,7 +475,7 @@ class NumbaBackend:
         return (grid.nx, grid.ny, bool(box.periodic), self._edges)
 
     def _filter(self) -> tuple:
-        return (self._seg, self._seg_start, self._seg_idx, self._filtering, self._group, self._blocked)
+        return (self._seg, self._seg_start, self._seg_idx, self._group, self._blocked, self._rest)
 
     def _queue(self) -> tuple:
         return (self._qt, self._bheap, self._bht, self._bpos, self._barg, self._qk, self._qo, self._qs, self._ints)
@@ -432,7 +490,7 @@ class NumbaBackend:
         return (
             self._rec, self._count, self._order, self._images, self._kept_partner, self._kept_stamp,
             self._cell, self._head, self._nxt,
-            *self._geometry(), *self._filter(), *self._queue(), self._floats,
+            *self._geometry(), *self._filter(), *self._queue(), self._floats, self._etab, self._egroup, self._tlast,
         )  # fmt: skip
 
 

@@ -31,10 +31,12 @@ import numpy as np
 
 from discsim._compiled import inline, jit, prefetch
 from discsim.events import EventKind
+from discsim.laws import E, GX, GY, PER_GROUP, REST_SPEED, TC
 from discsim.physics.compiled import (
     advance,
     cross,
     pair_predict,
+    closest_point_on_segment,
     pair_resolve,
     predict_x,
     predict_y,
@@ -52,11 +54,11 @@ COLLISION, WALL, CROSSING, SEGMENT = (
 # Columns of a disc's row in ``rec``.
 X, Y, VX, VY, T, R, M, KEPT = 0, 1, 2, 3, 4, 5, 6, 7
 # Slots of ``ints``.
-I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ = range(11)
-N_INTS = 11
+I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS = range(12)
+N_INTS = 12
 # Slots of ``floats``.
-F_EPOCH, F_VIRIAL, F_OVERLAP, F_TIME, F_LTIME = range(5)
-N_FLOATS = 5
+F_EPOCH, F_VIRIAL, F_OVERLAP, F_TIME, F_LTIME, F_LOST = range(6)
+N_FLOATS = 6
 # Why run_events returned: the queue holds nothing before ``until`` or the event limit was met; the
 # budget of pops or the log buffer ran out (call again); the crossing budget was spent.
 DONE, MORE, CROSSINGS = 0, 1, 2
@@ -152,12 +154,20 @@ def reblock(qt, bheap, bht, bpos, barg):
 
 
 # --- prediction ----------------------------------------------------------------------------------------
+@jit
+def accel(k, gravity, gx, gy, rec, rest):
+    """Disc ``k``'s acceleration: gravity, unless there is none, ``k`` is an obstacle or it is at rest."""
+    if gravity and rec[k, M] != INF and rest[k] == 0:
+        return gx, gy
+    return 0.0, 0.0
+
+
 @inline
 def predict(
     i, t, exclude, direction,
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
+    seg, seg_start, seg_idx, group, blocked, rest,
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
 ):  # fmt: skip
     """Schedule disc ``i``'s earliest event after ``t``, as the Python backend's ``predict`` does.
@@ -171,7 +181,10 @@ def predict(
     width = edges[nx]
     height = edges[nx + 1 + ny]
     ri = rec[i, R]
-    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
+    gx, gy = edges[nx + ny + 2 + GX], edges[nx + ny + 2 + GY]
+    gravity = gx != 0.0 or gy != 0.0
+    axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
     c = cell[i]
     cx = c // ny
     cy = c - cx * ny
@@ -180,6 +193,7 @@ def predict(
     after_crossing = direction >= 0 and (partner < 0 or count[partner] == kept_stamp[i])
     best = INF
     new_partner = -1
+    filtering = group.shape[0] != 0  # the filter's groups, or none (nothing passes through anything)
     gi = group[i] if filtering else 0
     for ddx in range(-1, 2):
         if after_crossing and ((direction == PLUS_X and ddx != 1) or (direction == MINUS_X and ddx != -1)):
@@ -218,9 +232,13 @@ def predict(
                 if j == i or j == exclude or (filtering and blocked[gi, group[j]]):
                     j = nxt[j]
                     continue
+                axj = ayj = 0.0
+                if gravity:  # (a well-predicted branch: free flight reads no more than before)
+                    axj, ayj = accel(j, gravity, gx, gy, rec, rest)
                 tij = pair_predict(
-                    rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], rec[j, R], offx, offy, vxi, vyi, ri
-                )
+                    rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], rec[j, R], offx, offy, vxi, vyi, ri,
+                    axj, ayj, axj - axi, ayj - ayi,
+                )  # fmt: skip
                 if tij < best:
                     best = tij
                     new_partner = j
@@ -243,17 +261,19 @@ def predict(
     # 2. The next wall, segment or cell boundary.
     walled = not periodic
     best, kind, other = predict_x(
-        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1
+        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1, axi
     )
     ty, kind_y, other_y = predict_y(
-        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1
+        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1, ayi
     )
     if ty < best:
         best, kind, other = ty, kind_y, other_y
     for m in range(seg_start[c], seg_start[c + 1]):
         k = seg_idx[m]
         if k != -2 - exclude:  # not the segment just left
-            ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3])
+            ts = segment_time_of_impact(
+                xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi
+            )
             if ts < best:
                 best, kind, other = ts, SEGMENT, k
     if best < 0.0:
@@ -269,10 +289,23 @@ def predict(
 
 
 @jit
+def restitution(i, j, now, law, etab, egroup, tlast):
+    """The coefficient of restitution of a collision of ``i`` and ``j`` (``i`` twice: a wall) at time ``now``:
+    one number or the pair of groups' (:class:`~discsim.laws.Laws`), 1 within the TC time of either's last."""
+    e = law[E]
+    if law[PER_GROUP] != 0.0:
+        e = etab[egroup[i], egroup[j]]
+    tc = law[TC]
+    if tc > 0.0 and (now - tlast[i] < tc or now - tlast[j] < tc):
+        e = 1.0
+    return e
+
+
+@jit
 def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
+    seg, seg_start, seg_idx, group, blocked, rest,
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
 ):  # fmt: skip
     """The start of a run: predict every moving disc at time 0, in internal order."""
@@ -281,7 +314,7 @@ def predict_all(
             predict(
                 i, 0.0, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
     ints[I_MAXQ] = ints[I_SIZE]
@@ -292,7 +325,7 @@ def set_disc(
     i, x, y, vx, vy, new_cell, t,
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
+    seg, seg_start, seg_idx, group, blocked, rest,
     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
 ):  # fmt: skip
     """Restart disc ``i``'s path at ``t`` from ``(x, y)`` with ``(vx, vy)`` (in cell ``new_cell``), as the Python
@@ -307,11 +340,12 @@ def set_disc(
     rec[i, VX] = vx
     rec[i, VY] = vy
     rec[i, T] = t
+    rest[i] = 0  # an edited disc falls again
     count[i] += 1
     predict(
         i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
         nx, ny, periodic, edges,
-        seg, seg_start, seg_idx, filtering, group, blocked,
+        seg, seg_start, seg_idx, group, blocked, rest,
         qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
     )  # fmt: skip
     if ints[I_SIZE] > ints[I_MAXQ]:
@@ -423,8 +457,8 @@ def run_events(
     until, limit, crossings, budget, rebase_every, recording,
     rec, count, order, images, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
-    seg, seg_start, seg_idx, filtering, group, blocked,
-    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats,
+    seg, seg_start, seg_idx, group, blocked, rest,
+    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats, etab, egroup, tlast,
     ev_t, ev_kind, ev_i, ev_j, ev_f,
 ):  # fmt: skip
     """Process events with times <= ``until``: the Python backend's ``process_events``, compiled.
@@ -438,6 +472,9 @@ def run_events(
     """
     width = edges[nx]
     height = edges[nx + 1 + ny]
+    law = edges[nx + ny + 2 :]  # the laws' numbers follow the cells' edges
+    gx, gy = law[GX], law[GY]
+    gravity = gx != 0.0 or gy != 0.0
     n_coll = n_wall = n_cross = n_stale = 0
     done = 0
     logged = 0
@@ -488,16 +525,50 @@ def run_events(
                 predict(
                     i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, periodic, edges,
-                    seg, seg_start, seg_idx, filtering, group, blocked,
+                    seg, seg_start, seg_idx, group, blocked, rest,
                     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
                 )  # fmt: skip
                 continue
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
-            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T])
             mi, mj = rec[i, M], rec[j, M]
+            axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+            axj, ayj = accel(j, gravity, gx, gy, rec, rest)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
+            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], axj, ayj)
+            e = restitution(i, j, t + epoch, law, etab, egroup, tlast)
             dx, dy, uxi, uyi, uxj, uyj = pair_resolve(
-                xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic
+                xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic, e
             )
+            moved_j = mj != INF  # obstacles never move, and their counter never changes
+            if gravity and (axi == 0.0) != (axj == 0.0):
+                # One falls onto a support (an obstacle or a disc at rest): too slow a bounce and it rests there.
+                if axi == 0.0:  # i supports j: the normal points from i to j
+                    bounce = -e * ((vxj - vxi) * dx + (vyj - vyi) * dy)
+                    up = -(gx * dx + gy * dy)
+                else:
+                    bounce = -e * ((vxi - vxj) * -dx + (vyi - vyj) * -dy)
+                    up = gx * dx + gy * dy
+                norm = math.sqrt(dx * dx + dy * dy)
+                if up > 0.0 and bounce < law[REST_SPEED] * norm:
+                    if axi == 0.0:
+                        uxi, uyi, uxj, uyj = vxi, vyi, 0.0, 0.0
+                        rest[j] = 1
+                    else:
+                        uxi, uyi, uxj, uyj = 0.0, 0.0, vxj, vyj
+                        rest[i] = 1
+                    ints[I_RESTS] += 1
+                else:  # hit hard enough: a support at rest wakes (an obstacle stays)
+                    rest[i] = 0
+                    if moved_j:
+                        rest[j] = 0
+            if e != 1.0 or gravity:
+                lost = 0.5 * mi * ((vxi * vxi + vyi * vyi) - (uxi * uxi + uyi * uyi))
+                if moved_j:
+                    lost += 0.5 * mj * ((vxj * vxj + vyj * vyj) - (uxj * uxj + uyj * uyj))
+                floats[F_LOST] += lost
+            if law[TC] > 0.0:
+                tlast[i] = t + epoch
+                if moved_j:
+                    tlast[j] = t + epoch
             overlap = 1.0 - math.sqrt(dx * dx + dy * dy) / (rec[i, R] + rec[j, R])
             if overlap > max_overlap:
                 max_overlap = overlap
@@ -516,33 +587,57 @@ def run_events(
                 ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, uxi, uyi
                 ev_f[logged, 4], ev_f[logged, 5], ev_f[logged, 6], ev_f[logged, 7] = xj, yj, uxj, uyj
                 logged += 1
+            # The pair cannot meet again before one of them changes course, unless one falls and the other
+            # does not (a ball bouncing on a disc at rest comes back): then neither is excluded.
+            alike = not gravity or (rest[i] == 0) == (moved_j and rest[j] == 0)
             predict(
-                i, t, j, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                i, t, j if alike else -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
-            if mj != INF:  # obstacles never move, and their counter never changes
+            if moved_j:
                 count[j] += 1
                 predict(
-                    j, t, i, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                    j, t, i if alike else -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                     nx, ny, periodic, edges,
-                    seg, seg_start, seg_idx, filtering, group, blocked,
+                    seg, seg_start, seg_idx, group, blocked, rest,
                     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
                 )  # fmt: skip
                 if ints[I_SIZE] > max_queue:
                     max_queue = ints[I_SIZE]
             last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j
         elif kind == WALL or kind == SEGMENT:
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T])
+            axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
+            e = restitution(i, i, t + epoch, law, etab, egroup, tlast)
+            wx, wy = vxi, vyi
             if kind == SEGMENT:
                 vxi, vyi = reflect_off_segment(
-                    xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
+                    xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], e
                 )
-                exclude = -2 - other  # never the same segment again straight away
+                # never the same segment again straight away (a falling disc may come back: not excluded)
+                exclude = -1 if gravity else -2 - other
             else:
-                vxi, vyi = reflect(vxi, vyi, other)
+                vxi, vyi = reflect(vxi, vyi, other, e)
                 exclude = -1
+            if gravity:  # too slow a bounce off a floor (a support with gravity into it): the disc rests
+                if kind == SEGMENT:
+                    qx, qy = closest_point_on_segment(xi, yi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3])
+                    nxw, nyw = xi - qx, yi - qy
+                elif other == 0:
+                    nxw, nyw = (1.0 if xi < 0.5 * width else -1.0), 0.0
+                else:
+                    nxw, nyw = 0.0, (1.0 if yi < 0.5 * height else -1.0)
+                norm = math.sqrt(nxw * nxw + nyw * nyw)
+                if gx * nxw + gy * nyw < 0.0 and vxi * nxw + vyi * nyw < law[REST_SPEED] * norm:
+                    vxi = vyi = 0.0
+                    rest[i] = 1
+                    ints[I_RESTS] += 1
+            if e != 1.0 or gravity:
+                floats[F_LOST] += 0.5 * rec[i, M] * ((wx * wx + wy * wy) - (vxi * vxi + vyi * vyi))
+            if law[TC] > 0.0:
+                tlast[i] = t + epoch
             rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], rec[i, T] = xi, yi, vxi, vyi, t
             count[i] += 1
             n_wall += 1
@@ -558,7 +653,7 @@ def run_events(
             predict(
                 i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
@@ -579,7 +674,7 @@ def run_events(
             predict(
                 i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, filtering, group, blocked,
+                seg, seg_start, seg_idx, group, blocked, rest,
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             if n_cross == crossings:

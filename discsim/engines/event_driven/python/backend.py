@@ -224,6 +224,8 @@ class PythonBackend:
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.maximum(others, 0)], others) if len(kinds) else others,
             queue_stamp=np.array([p[2] for _, _, p in pending], dtype=np.int64),
+            resting=np.zeros(n, dtype=np.int64),  # this loop runs the default laws only (EventDriven's rule)
+            last_collision=np.full(n, -np.inf),
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:

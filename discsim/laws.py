@@ -1,0 +1,177 @@
+"""The laws a run uses, as the user chose them: gravity, restitution (with the TC model) and rest, validated once.
+
+:class:`Laws` is what every engine takes from its ``gravity=``, ``restitution=``, ``tc=`` and ``rest_speed=``
+keywords: it checks them (a :class:`~discsim.errors.DiscsimError` naming the argument and its value, before
+anything changes), stores them in a run's settings and checkpoints, and gives the compiled loops their numbers
+as one small float array (:meth:`Laws.array`) and one table (:meth:`Laws.table`). The defaults are today's
+physics, free flight and elastic collisions, bit for bit (:attr:`Laws.default`).
+
+Example:
+    >>> laws = Laws.build(gravity=(0.0, -9.81), restitution=0.8)
+    >>> laws.gravity, laws.default
+    ((0.0, -9.81), False)
+    >>> Laws.build().default
+    True
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from discsim.errors import InvalidArgumentError
+
+__all__ = ["LAW_SLOTS", "Laws"]
+
+#: Slots of :meth:`Laws.array`: gravity along x and y, the rest speed, the TC time, whether the restitution
+#: depends on the pair of groups (1.0) or is one number (0.0), and that number.
+GX, GY, REST_SPEED, TC, PER_GROUP, E = range(6)
+LAW_SLOTS = 6
+#: The default rest speed, as a bounce height: a disc that would bounce less high than this fraction of the
+#: smallest radius comes to rest (see :class:`Laws`).
+REST_HEIGHT = 1e-3
+
+
+def _number(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        msg = f"{name} must be a number, got {value!r}"
+        raise InvalidArgumentError(msg)
+    return float(value)
+
+
+def _coefficient(name: str, value) -> float:
+    e = _number(name, value)
+    if not 0.0 <= e <= 1.0:
+        msg = f"{name} must lie in [0, 1], got {value!r}"
+        raise InvalidArgumentError(msg)
+    return e
+
+
+@dataclass(frozen=True)
+class Laws:
+    """The laws of one run (build it with :meth:`build`, which checks every value).
+
+    Attributes:
+        gravity: ``(gx, gy)``, the uniform acceleration of every disc of finite mass (length / time^2);
+            ``(0.0, 0.0)``: none.
+        restitution: the normal coefficient of restitution ``e`` in [0, 1] of every collision (1: elastic), or
+            a dict from sorted pairs of group labels (``discs.groups``) to ``e``; pairs it does not name are
+            elastic, and a disc's bounce off a wall or a segment uses its group's pair with itself.
+        tc: the TC model's time (Luding & McNamara 1998): a collision within ``tc`` of either disc's previous
+            collision is elastic, the guard against inelastic collapse; 0: none.
+        rest_speed: under gravity, a disc whose speed away from a support (a wall, a segment, an obstacle or a
+            disc at rest) after an impact is below this comes to rest there (velocity zero, gravity off) until
+            something hits it harder (see ``docs/laws.md``); None: the speed of a bounce
+            :data:`REST_HEIGHT` times the smallest radius high.
+    """
+
+    gravity: tuple[float, float] = (0.0, 0.0)
+    restitution: float | dict = 1.0
+    tc: float = 0.0
+    rest_speed: float | None = None
+    _pairs: tuple = field(default=(), repr=False)
+
+    @classmethod
+    def build(cls, gravity=None, restitution=1.0, tc=0.0, rest_speed=None) -> Laws:
+        """Check the keywords as the engines take them and build the laws.
+
+        Raises:
+            InvalidArgumentError: naming the argument and value: gravity not a pair of finite numbers, a
+                restitution outside [0, 1] (or a malformed dict), a negative or non-finite ``tc`` or
+                ``rest_speed``.
+        """
+        if gravity is None:
+            g = (0.0, 0.0)
+        else:
+            try:
+                pair = tuple(gravity)
+            except TypeError:
+                pair = ()
+            if len(pair) != 2 or not all(math.isfinite(_number("gravity", v)) for v in pair):
+                msg = f"gravity must be None or a pair (gx, gy) of finite numbers, got {gravity!r}"
+                raise InvalidArgumentError(msg)
+            g = (float(pair[0]), float(pair[1]))
+        pairs: tuple = ()
+        if isinstance(restitution, dict):
+            checked = {}
+            for key, value in restitution.items():
+                try:
+                    a, b = key
+                    labels = (int(a), int(b))
+                except (TypeError, ValueError):
+                    labels = None
+                if labels is None or labels != tuple(key):
+                    msg = f"restitution keys must be pairs of group labels (integers), got {key!r}"
+                    raise InvalidArgumentError(msg)
+                checked[(min(labels), max(labels))] = _coefficient(f"restitution[{key!r}]", value)
+            e: float | dict = checked
+            pairs = tuple(sorted(checked.items()))
+        else:
+            e = _coefficient("restitution", restitution)
+        tc = _number("tc", tc)
+        if not (math.isfinite(tc) and tc >= 0.0):
+            msg = f"tc must be a finite number >= 0, got {tc!r}"
+            raise InvalidArgumentError(msg)
+        if rest_speed is not None:
+            rest_speed = _number("rest_speed", rest_speed)
+            if not (math.isfinite(rest_speed) and rest_speed >= 0.0):
+                msg = f"rest_speed must be None or a finite number >= 0, got {rest_speed!r}"
+                raise InvalidArgumentError(msg)
+        return cls(g, e, tc, rest_speed, pairs)
+
+    @property
+    def default(self) -> bool:
+        """True for free flight and elastic collisions: today's physics, bit for bit."""
+        return self.gravity == (0.0, 0.0) and not self._pairs and self.restitution == 1.0
+
+    @property
+    def falls(self) -> bool:
+        """True under gravity."""
+        return self.gravity != (0.0, 0.0)
+
+    def settings(self) -> dict:
+        """The laws as a run's settings store them (plain JSON: pairs of groups as ``"a,b"`` keys)."""
+        e = {f"{a},{b}": v for (a, b), v in self._pairs} if self._pairs else self.restitution
+        return {"gravity": list(self.gravity), "restitution": e, "tc": self.tc, "rest_speed": self.rest_speed}
+
+    @classmethod
+    def from_settings(cls, settings: dict) -> Laws:
+        """The laws stored by :meth:`settings` (absent: the defaults, as every run before the laws)."""
+        e = settings.get("restitution", 1.0)
+        if isinstance(e, dict):
+            e = {tuple(int(v) for v in key.split(",")): value for key, value in e.items()}
+        gravity = settings.get("gravity")
+        return cls.build(gravity, e, settings.get("tc", 0.0), settings.get("rest_speed"))
+
+    def rest_speed_for(self, radii: np.ndarray) -> float:
+        """The rest speed a run of discs of ``radii`` uses (0 without gravity)."""
+        if not self.falls:
+            return 0.0
+        if self.rest_speed is not None:
+            return self.rest_speed
+        r = float(np.min(radii)) if len(radii) else 1.0
+        return math.sqrt(2.0 * math.hypot(*self.gravity) * REST_HEIGHT * r)
+
+    def array(self, radii: np.ndarray) -> np.ndarray:
+        """The numbers the compiled loops read, ``(LAW_SLOTS,)`` float64 (see the slot names above)."""
+        out = np.zeros(LAW_SLOTS)
+        out[GX], out[GY] = self.gravity
+        out[REST_SPEED] = self.rest_speed_for(radii)
+        out[TC] = self.tc
+        out[PER_GROUP] = 1.0 if self._pairs else 0.0
+        out[E] = 1.0 if self._pairs else float(self.restitution)  # type: ignore[arg-type]
+        return out
+
+    def table(self, labels: np.ndarray) -> np.ndarray:
+        """``(G, G)`` restitution between the groups ``labels`` (sorted distinct labels; as
+        :func:`discsim.scene.filter_table` numbers them); all ones for a single number (unused then)."""
+        g = len(labels)
+        out = np.ones((max(g, 1), max(g, 1)))
+        lookup = dict(self._pairs)
+        names = [int(v) for v in labels]
+        for a, la in enumerate(names):
+            for b, lb in enumerate(names):
+                out[a, b] = lookup.get((min(la, lb), max(la, lb)), 1.0)
+        return out

@@ -1,0 +1,220 @@
+"""Gravity, restitution (with the TC model) and rest in the event-driven engine: closed forms, invariants,
+both backends bit for bit, checkpoints, bad input (issue 27, items 1, 2 and 6)."""
+
+import math
+
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim.errors import InvalidArgumentError, JammedError
+
+G = 9.81
+BOX = ds.Box(10.0, 10.0)
+
+
+def ball(x, y, vx=0.0, vy=0.0, r=1.0):
+    return ds.Discs([[x, y]], [[vx, vy]], radii=r)
+
+
+def times(sim, kind=None):
+    return np.array([e["time"] for e in sim.events if kind is None or e["kind"] == kind])
+
+
+# --- gravity: closed forms ------------------------------------------------------------------------------
+@pytest.mark.parametrize("vx, vy", [(0.0, 0.0), (1.3, 2.0), (-0.7, -3.0)])
+def test_a_projectile_reaches_the_floor_at_the_exact_time(every_backend, vx, vy):
+    y0, r = 6.5, 1.0
+    sim = ds.EventDriven(ball(5.0, y0, vx, vy, r), BOX, gravity=(0.0, -G))
+    event = sim.step()
+    exact = (vy + math.sqrt(vy * vy + 2.0 * G * (y0 - r))) / G
+    assert event.kind == "wall"
+    assert event.time == pytest.approx(exact, rel=1e-13)
+    assert sim.positions[0] == pytest.approx([5.0 + vx * exact, r], rel=1e-13)
+    assert sim.velocities[0] == pytest.approx([vx, G * exact - vy], rel=1e-12)  # elastic: vy reversed
+
+
+def test_a_bouncing_ball_loses_height_geometrically_and_comes_to_rest(every_backend):
+    e, h0, r = 0.8, 5.0, 1.0
+    sim = ds.EventDriven(ball(5.0, r + h0, r=r), BOX, gravity=(0.0, -G), restitution=e)
+    sim.run(until=60.0)
+    hits = times(sim)
+    v1 = math.sqrt(2.0 * G * h0)
+    # Bounce k (from 0) at sqrt(2 h0 / g) + sum of the flights 2 e^m v1 / g: heights e^(2k) h0.
+    k = np.arange(len(hits) - 1)
+    flights = 2.0 * e ** (k + 1) * v1 / G
+    exact = np.concatenate([[v1 / G], v1 / G + np.cumsum(flights)])
+    assert hits == pytest.approx(exact, rel=1e-10)
+    # It comes to rest on the floor: the bounce that would rise less than 1e-3 r never happens.
+    assert sim.counts["rests"] == 1 and sim.resting.tolist() == [True]
+    last_bounce = v1 * e ** len(hits)
+    assert last_bounce < math.sqrt(2 * G * 1e-3 * r) <= last_bounce / e
+    assert sim.positions[0] == pytest.approx([5.0, r]) and sim.velocities.tolist() == [[0.0, 0.0]]
+    # The energy lost is the energy it had above the floor.
+    assert sim.dissipated == pytest.approx(G * h0, rel=1e-12)
+    assert sim.energy() == pytest.approx(G * r, rel=1e-12)
+    assert sim.potential_energy() == pytest.approx(G * r, rel=1e-12)
+
+
+def test_a_ball_bounces_on_an_obstacle_and_comes_back_to_it(every_backend):
+    # Dropped from 3 above the contact onto a fixed disc: contact at sqrt(2 h / g), elastic, back again.
+    h = 3.0
+    discs = ds.Discs([[5.0, 2.0], [5.0, 4.0 + h]], [[0.0, 0.0], [0.0, 0.0]], radii=1.0, masses=[np.inf, 1.0])
+    sim = ds.EventDriven(discs, BOX, gravity=(0.0, -G))
+    first = sim.step()
+    assert first.kind == "collision" and first.time == pytest.approx(math.sqrt(2 * h / G), rel=1e-12)
+    second = sim.step()
+    assert second.kind == "collision"
+    assert second.time == pytest.approx(3 * math.sqrt(2 * h / G), rel=1e-9)  # up and down again: no tunnelling
+    assert sim.positions[0].tolist() == [5.0, 2.0]  # the obstacle does not fall
+
+
+def test_a_ball_bounces_on_a_segment_again_and_again(every_backend):
+    h = 2.0
+    floor = ds.Segment((1.0, 3.0), (9.0, 3.0))
+    sim = ds.EventDriven(ball(5.0, 4.0 + h), BOX, gravity=(0.0, -G), segments=[floor])
+    sim.run(events=4)
+    t1 = math.sqrt(2 * h / G)
+    assert times(sim) == pytest.approx([t1, 3 * t1, 5 * t1, 7 * t1], rel=1e-9)
+    assert sim.positions[0, 1] > 3.0 + 1.0 - 1e-9  # never fell through
+
+
+def test_a_ball_dropped_on_a_segments_end_point(every_backend):
+    # The end point (5, 3) is a fixed point: the contact is at distance r, at the quartic's root.
+    floor = ds.Segment((1.0, 3.0), (5.0, 3.0))
+    x0, y0 = 5.6, 7.0
+    sim = ds.EventDriven(ball(x0, y0), BOX, gravity=(0.0, -G), segments=[floor])
+    event = sim.step()
+    drop = y0 - (3.0 + math.sqrt(1.0 - 0.6**2))  # falls until the end point is one radius away
+    assert event.time == pytest.approx(math.sqrt(2 * drop / G), rel=1e-9)
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+@pytest.mark.parametrize("gravity", [(0.0, -G), (G, 0.0), (3.0, -4.0)])
+def test_elastic_gas_under_gravity_conserves_energy_and_both_backends_agree(gravity, periodic):
+    discs, box = ds.random_gas(40, 0.3, seed=4, periodic=periodic)
+    runs = {}
+    for backend in ("python", "numba"):
+        if backend == "numba" and not ds._numba.available():
+            pytest.skip("numba is not installed")
+        sim = ds.EventDriven(discs, box, gravity=gravity, backend=backend)
+        e0 = sim.energy()
+        sim.run(events=1500)
+        assert sim.counts.get("rests", 0) == 0
+        assert sim.energy() == pytest.approx(e0, rel=1e-9)
+        assert sim.dissipated == pytest.approx(0.0, abs=1e-9 * e0)
+        sim._check()
+        runs[backend] = sim
+    assert np.array_equal(runs["python"].events, runs["numba"].events)  # bit for bit
+    assert runs["python"].backend == "python" and runs["numba"].backend == "numba"
+
+
+def test_an_inelastic_gas_poured_into_a_box_settles_to_rest(every_backend):
+    rng = np.random.default_rng(2)
+    xs, ys = np.meshgrid(np.arange(1.5, 9.0, 2.1), np.arange(1.5, 9.0, 2.1))
+    pos = np.column_stack([xs.ravel(), ys.ravel()])
+    discs = ds.Discs(pos, rng.normal(size=pos.shape), radii=0.9)
+    sim = ds.EventDriven(discs, BOX, gravity=(0.0, -G), restitution=0.6, tc=1e-4)
+    e0 = sim.energy()
+    sim.run(until=40.0)
+    assert sim.resting.all()
+    assert sim.energy() + sim.dissipated == pytest.approx(e0, rel=1e-9)
+    assert (sim.positions[:, 1] >= 0.9 - 1e-9).all()
+    d = sim.positions[:, None] - sim.positions[None]
+    dist = np.hypot(d[..., 0], d[..., 1]) + np.eye(len(pos)) * 10
+    assert dist.min() >= 1.8 * (1 - 1e-9)  # no overlap
+    sim._check()
+
+
+# --- restitution and the TC model ------------------------------------------------------------------------
+@pytest.mark.parametrize("e", [0.0, 0.3, 0.9])
+def test_head_on_collision_with_restitution(every_backend, e):
+    discs = ds.Discs([[2.0, 5.0], [6.0, 5.0]], [[2.0, 0.0], [-1.0, 0.0]], radii=1.0, masses=[1.0, 3.0])
+    sim = ds.EventDriven(discs, BOX, restitution=e)
+    sim.step()
+    (u1, _), (u2, _) = sim.velocities
+    assert 1.0 * u1 + 3.0 * u2 == pytest.approx(2.0 - 3.0)  # momentum
+    assert u2 - u1 == pytest.approx(e * 3.0)  # the closing speed, scaled by e
+    mu = 3.0 / 4.0
+    assert sim.dissipated == pytest.approx(0.5 * mu * (1 - e * e) * 9.0)
+
+
+def test_restitution_per_pair_of_groups(every_backend):
+    discs = ds.Discs(
+        [[2.0, 2.0], [5.0, 2.0], [2.0, 7.0], [5.0, 7.0]],
+        [[1.0, 0.0], [0.0, 0.0], [1.0, 0.0], [0.0, 0.0]],
+        radii=1.0,
+        groups=[0, 1, 0, 0],
+    )
+    sim = ds.EventDriven(discs, BOX, restitution={(0, 1): 0.5})
+    sim.run(until=1.5)
+    assert sim.velocities[:2, 0] == pytest.approx([0.25, 0.75])  # groups 0 and 1: e = 0.5
+    assert sim.velocities[2:, 0] == pytest.approx([0.0, 1.0])  # groups 0 and 0: elastic
+
+
+def test_the_tc_model_makes_a_quick_second_collision_elastic(every_backend):
+    # Disc 0 hits disc 1, which hits the wall and comes straight back: the second collision of 0 and 1 follows
+    # within tc of their first and is elastic.
+    discs = ds.Discs([[6.0, 5.0], [8.5, 5.0]], [[1.0, 0.0], [0.0, 0.0]], radii=1.0)
+    plain = ds.EventDriven(discs, BOX, restitution=0.5).run(events=3)
+    tc = ds.EventDriven(discs, BOX, restitution=0.5, tc=2.0).run(events=3)
+    assert [e["kind"] for e in plain.events] == [0, 1, 0]
+    assert tc.dissipated == pytest.approx(0.5 * 0.5 * (1 - 0.25) * 1.0)  # the first collision only
+    assert plain.dissipated > tc.dissipated
+
+
+def test_inelastic_collapse_ends_with_a_clear_error_never_a_hang(every_backend):
+    # Three discs closing in a line with e far below the collapse threshold of three (7 - 4 sqrt 3 = 0.072).
+    discs = ds.Discs([[2.0, 5.0], [4.5, 5.0], [7.0, 5.0]], [[1.0, 0.0], [0.0, 0.0], [-1.0, 0.0]], radii=1.0)
+    sim = ds.EventDriven(discs, BOX, restitution=0.02)
+    with pytest.raises(JammedError, match="disc"):
+        sim.run(until=10.0)
+    sim._check()  # consistent at its last whole event
+
+
+# --- state, checkpoints, defaults, bad input ---------------------------------------------------------------
+def test_a_run_under_the_laws_continues_from_a_checkpoint_bit_for_bit(every_backend, tmp_path):
+    discs, box = ds.random_gas(30, 0.3, seed=9)
+    laws = {"gravity": (0.0, -2.0), "restitution": 0.9, "tc": 1e-3}
+    whole = ds.EventDriven(discs, box, **laws).run(events=600)
+    half = ds.EventDriven(discs, box, **laws).run(events=300)
+    half.save(tmp_path / "half.dsc")
+    resumed = ds.load(tmp_path / "half.dsc").run(events=300)
+    assert resumed.laws == whole.laws
+    assert np.array_equal(resumed.events[-300:], whole.events[-300:])
+    assert resumed.dissipated == whole.dissipated and resumed.resting.tolist() == whole.resting.tolist()
+
+
+def test_the_defaults_are_todays_physics():
+    discs, box = ds.random_gas(30, 0.3, seed=1)
+    plain = ds.EventDriven(discs, box, backend="python").run(events=300)
+    spelled = ds.EventDriven(
+        discs, box, backend="python", gravity=None, restitution=1.0, tc=0.0, rest_speed=None
+    ).run(events=300)
+    assert np.array_equal(plain.events, spelled.events)
+    assert spelled.laws.default and spelled.dissipated == 0.0 and spelled.potential_energy() == 0.0
+
+
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"restitution": 1.5}, "restitution"),
+        ({"restitution": -0.1}, "restitution"),
+        ({"restitution": "high"}, "restitution"),
+        ({"restitution": {(0, "a"): 0.5}}, "restitution"),
+        ({"gravity": (math.nan, 0.0)}, "gravity"),
+        ({"gravity": (1.0,)}, "gravity"),
+        ({"gravity": "down"}, "gravity"),
+        ({"tc": -1.0}, "tc"),
+        ({"rest_speed": -1.0}, "rest_speed"),
+    ],
+)
+def test_bad_laws_are_refused_naming_the_argument(kwargs, name):
+    with pytest.raises(InvalidArgumentError, match=name):
+        ds.EventDriven(ball(5.0, 5.0), BOX, **kwargs)
+
+
+def test_pressure_under_gravity_is_refused_with_a_reason():
+    sim = ds.EventDriven(ball(5.0, 5.0, 1.0), BOX, gravity=(0.0, -G)).run(until=1.0)
+    with pytest.raises(InvalidArgumentError, match="varies with height"):
+        sim.pressure()

@@ -13,7 +13,8 @@ import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Tally
 from discsim.errors import InvalidArgumentError
-from discsim.model import Box, _readonly
+from discsim.laws import Laws
+from discsim.model import Box, Discs, _readonly
 
 __all__ = ["FrameReadout"]
 
@@ -23,6 +24,8 @@ class FrameReadout:
 
     # What the engine provides (declared for readers and the type checker).
     box: Box
+    discs: Discs
+    laws: Laws
     time: float
     start_time: float
     frame_rate: float
@@ -77,8 +80,36 @@ class FrameReadout:
 
     @property
     def velocities(self) -> np.ndarray:
-        """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
+        """``(N, 2)`` velocities at ``time`` (a fresh copy; under gravity, between frames, on the parabola)."""
+        if self._paths.falls is not None and self.time != self._frame_time:
+            return _readonly(self._paths.velocities_at(self.time))
         return _readonly(self._paths.velocities.copy())
+
+    @property
+    def dissipated(self) -> float:
+        """Kinetic energy taken since the start by the responses with restitution below 1 (0 for elastic discs).
+
+        Only the collision law's loss: what the frames' own errors add or take (a disc that sinks into the
+        floor before its bounce, ``"separate"`` lifting it out, ``"revert"`` sending it back) is not counted,
+        so ``energy() + dissipated`` drifts from its start by the stepping's error alone.
+        """
+        return self._tally.dissipated
+
+    def potential_energy(self) -> float:
+        """The potential energy in the gravity field, ``-sum(m g . r)`` over the discs of finite mass (zero at the
+        origin of the box; 0 without gravity). ``r`` is the unwrapped centre in a periodic box. Units: mass
+        length^2 / time^2."""
+        if not self.laws.falls:
+            return 0.0
+        masses = self.discs.masses
+        finite = np.isfinite(masses)
+        g = np.array(self.laws.gravity)
+        return float(-np.sum(masses[finite] * (self.unwrapped_positions[finite] @ g)))
+
+    def energy(self) -> float:
+        """Kinetic plus potential energy. An exact run would keep it with ``restitution=1``; a fixed-step run
+        changes it by the stepping's error (see :attr:`dissipated`)."""
+        return self.kinetic_energy() + self.potential_energy()
 
     def pressure(self) -> float:
         """Pressure from the virial of the impulses the frames applied, averaged since the start.
@@ -116,6 +147,12 @@ class FrameReadout:
         elapsed = self.time - self.start_time
         if elapsed <= 0:
             msg = "pressure() needs a run of positive duration"
+            raise InvalidArgumentError(msg)
+        if self.laws.falls:
+            msg = (
+                f"pressure() is the bulk pressure of a uniform gas; under gravity {self.laws.gravity} the "
+                "pressure varies with height (measure the density profile instead)"
+            )
             raise InvalidArgumentError(msg)
         virial = self._tally.virial
         if math.isnan(virial):

@@ -104,24 +104,18 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             imports, else ``"python"``),
             ``"numba"`` (the frame compiled, from the ``fast`` extra: ``pip install
             "discsim[fast]"``) or ``"python"`` (numpy). Both give the same frames bit for bit.
-        gravity: ``(gx, gy)``, a uniform acceleration of every disc of finite mass (length / time^2), as for
-            :class:`~discsim.engines.event_driven.EventDriven`; None: none. A frame moves each such disc along
-            the exact parabola, ``x += v dt + g dt^2 / 2``, ``v += g dt``; obstacles and segments stay put.
-            The frame policies only (``"resolve"``, ``"revert"``, ``"separate"``): the sub-frame ones follow
-            straight paths inside a frame and refuse it.
-        restitution: the normal coefficient of restitution ``e`` in [0, 1] of every response at a frame
-            (pairs, walls, segments; 1: elastic), or a dict from pairs of group labels to ``e`` (pairs not
-            named are elastic; a bounce off a wall or segment uses the disc's group's pair with itself). The
-            kinetic energy it takes is :attr:`dissipated`.
-        tc: the TC model's time (Luding & McNamara 1998): a response within ``tc`` of either disc's previous
-            response is elastic; 0: none.
-        rest_speed: accepted for the same keywords as ``EventDriven`` (and checked alike), and ignored: a
-            fixed-step run has no rest; a disc on a floor keeps bouncing from frame to frame.
+        gravity, restitution, tc: the laws of :class:`~discsim.engines.event_driven.EventDriven`, alike:
+            ``(gx, gy)`` (length / time^2; None: none) moves each disc of finite mass along the exact parabola
+            over a frame (``x += v dt + g dt^2 / 2``, ``v += g dt``; the frame policies only: ``"bisect"`` and
+            ``"swept"`` follow straight paths inside a frame and refuse it); ``e`` in [0, 1] (or per pair of
+            groups) at every response, the energy taken in :attr:`dissipated`; the TC time (0: none).
+        rest_speed: checked as ``EventDriven`` checks it, and ignored: PIT has no rest (a disc on a floor
+            keeps bouncing from frame to frame).
 
     Raises:
         InvalidArgumentError: on a frame rate, ``dt`` or ``bisect_tol`` that is
-            not a positive finite number, a law out of range (as for ``EventDriven``, naming the
-            argument), gravity with a sub-frame policy, both of ``frame_rate`` and ``dt`` given
+            not a positive finite number, a law refused as ``EventDriven`` refuses it, gravity with a
+            sub-frame policy, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
             a periodic box, ``backend="numba"`` without numba (naming the extra to
             install).
@@ -190,7 +184,6 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         tc: float = 0.0,
         rest_speed: float | None = None,
     ):
-        laws = Laws.build(gravity, restitution, tc, rest_speed)
         if dt is None:
             rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
             step, by_rate = 1.0 / rate, True
@@ -209,16 +202,14 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
-        _check_laws(laws, policy)
+        laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed), policy)
         backend = _choose_backend(backend, policy)
-        self._configure(
-            Scene(discs, box, segments, pass_through), record, rate, step, by_rate, policy, broad_phase, tol, backend,
-            laws,
-        )  # fmt: skip
+        scene = Scene(discs, box, segments, pass_through)
+        self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws)
         self._load(self._initial_state())
 
     def _configure(
-        self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend, laws: Laws
+        self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend, laws
     ) -> None:
         """Build the parts the options choose (checked already; ``backend`` resolved); the run state comes
         from :meth:`_load`.
@@ -255,8 +246,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         next frame."""
         parts = self._parts(scene)  # may refuse the new discs: nothing changed
         state = self.state()
-        names = ("ref_positions", "velocities", "ref_times", "last_collision")
-        arrays = {name: getattr(state, name)[keep] for name in names}
+        arrays = {n: getattr(state, n)[keep] for n in ("ref_positions", "velocities", "ref_times", "last_collision")}
         arrays.update(images=state.images[keep], frame_positions=state.frame_positions[keep])
         if added is not None:
             k, t = len(added), self.time
@@ -301,12 +291,6 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         if settings["policy"] not in COMPILED_POLICIES:  # no compiled frame: every backend runs it in Python
             backend = "python"
         backend = _choose_backend(backend, settings["policy"])
-        try:
-            laws = Laws.from_settings(settings.get("laws", {}))
-            _check_laws(laws, settings["policy"])
-        except InvalidArgumentError as exc:
-            msg = f"the checkpoint's laws cannot be used: {exc}"
-            raise CheckpointError(msg) from exc
         sim._configure(
             scene,
             settings["record"],
@@ -317,7 +301,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             settings["broad_phase"],
             float(settings["bisect_tol"]),
             backend,
-            laws,
+            _restored_laws(settings),
         )
         sim.start_time = start_time
         sim._edits = int(settings.get("edits", 0))
@@ -436,37 +420,6 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             checkpoint_every=checkpoint_every,
         )
 
-    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
-        """Positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log (see
-        :meth:`~discsim.engines.record.EventRecord.trajectory`).
-
-        Under gravity each disc of finite mass follows its parabola from its last record (the log's straight
-        path plus ``g dt^2 / 2``, ``dt`` the time since that record): the engine's own positions at the
-        frames, to rounding.
-
-        Raises:
-            InvalidArgumentError: as the log's trajectory; and under gravity, after ``add_discs`` or
-                ``remove_discs`` (not rebuilt).
-        """
-        out = super().trajectory(times, unwrapped=unwrapped)
-        falls = self._shapes.falls
-        if not falls.any():
-            return out
-        if self.run_context.origin is not None:
-            msg = "trajectory() under gravity is not rebuilt after add_discs or remove_discs"
-            raise InvalidArgumentError(msg)
-        asked = np.atleast_1d(np.asarray(times, dtype=float))
-        events = self.events
-        g = np.array(self.laws.gravity)
-        for d in np.flatnonzero(falls).tolist():
-            records = events["time"][(events["i"] == d) | (events["j"] == d)]  # in time order
-            last = np.concatenate([[self.start_time], records])[np.searchsorted(records, asked, side="right")]
-            since = asked - last
-            out[:, d] += 0.5 * g * (since * since)[:, None]
-        if self.box.periodic and not unwrapped:
-            out = self.box.wrap(out)
-        return out
-
     def step(self) -> list[Event]:
         """Do one frame: move, test, respond.
 
@@ -525,8 +478,22 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         tally.counts["frames"] = k + count
 
 
-def _check_laws(laws: Laws, policy: str) -> None:
-    """Refuse laws that ``policy`` cannot follow: gravity inside a frame (the sub-frame policies' paths are straight).
+def _restored_laws(settings: dict) -> Laws:
+    """The laws a checkpoint's settings hold (none: the defaults), checked as the constructor checks them.
+
+    Raises:
+        CheckpointError: naming what the constructor would refuse.
+    """
+    try:
+        return _check_laws(Laws.from_settings(settings.get("laws", {})), settings["policy"])
+    except InvalidArgumentError as exc:
+        msg = f"the checkpoint's laws cannot be used: {exc}"
+        raise CheckpointError(msg) from exc
+
+
+def _check_laws(laws: Laws, policy: str) -> Laws:
+    """``laws``, unless ``policy`` cannot follow them: gravity inside a frame (the sub-frame policies' paths are
+    straight).
 
     Raises:
         InvalidArgumentError: naming the gravity and the policy.
@@ -537,6 +504,7 @@ def _check_laws(laws: Laws, policy: str) -> None:
             f"policy {policy!r} finds contacts inside a frame along straight paths"
         )
         raise InvalidArgumentError(msg)
+    return laws
 
 
 def _choose_backend(backend, policy: str) -> str:

@@ -144,7 +144,7 @@ class FramePolicy(Policy):
             if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
             x, y = self.off_segment(x, y, qx, qy, nx, ny, r)
-            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e)
+            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e=e)
             responded = True
         return x, y, vx, vy, responded
 
@@ -356,12 +356,12 @@ class Revert(FramePolicy):
                     fx, fy = x, y
                     x, y = px, py
                     reverted = True
-                    vx, vy = reflect_off_segment(fx, fy, vx, vy, *ends, e)
+                    vx, vy = reflect_off_segment(fx, fy, vx, vy, *ends, e=e)
                     responded = True
                     continue
             if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
-            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e)
+            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e=e)
             responded = True
         return x, y, vx, vy, responded
 

@@ -1,4 +1,5 @@
-"""What a fixed-step run shows: positions and velocities at any time, the counters, the pressure, the frame clock.
+"""What a fixed-step run shows: positions and velocities at any time, the counters, the pressure, the energies,
+the trajectory under gravity, the frame clock.
 
 :class:`FrameReadout` is the read-only side of :class:`~discsim.engines.fixed_step.engine.FixedStep`: it reads
 the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and changes nothing.
@@ -7,11 +8,11 @@ the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Tally
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.errors import InvalidArgumentError
 from discsim.laws import Laws
 from discsim.model import Box, Discs, _readonly
@@ -34,10 +35,15 @@ class FrameReadout:
     _frame_time: float
     _paths: Paths
     _tally: Tally
+    _shapes: Shapes
+    run_context: Any
 
     if TYPE_CHECKING:
 
         def kinetic_energy(self) -> float: ...  # Engine's
+
+        @property
+        def events(self) -> np.ndarray: ...  # EventRecord's
 
     @property
     def frames(self) -> int:
@@ -162,6 +168,37 @@ class FrameReadout:
             )
             raise InvalidArgumentError(msg)
         return (self.kinetic_energy() + virial / (2.0 * elapsed)) / self.box.area
+
+    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
+        """Positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log (see
+        :meth:`~discsim.engines.record.EventRecord.trajectory`).
+
+        Under gravity each disc of finite mass follows its parabola from its last record (the log's straight
+        path plus ``g dt^2 / 2``, ``dt`` the time since that record): the engine's own positions at the
+        frames, to rounding.
+
+        Raises:
+            InvalidArgumentError: as the log's trajectory; and under gravity, after ``add_discs`` or
+                ``remove_discs`` (not rebuilt).
+        """
+        out = super().trajectory(times, unwrapped=unwrapped)  # type: ignore[misc]  # the log's (EventRecord)
+        falls = self._shapes.falls
+        if not falls.any():
+            return out
+        if self.run_context.origin is not None:
+            msg = "trajectory() under gravity is not rebuilt after add_discs or remove_discs"
+            raise InvalidArgumentError(msg)
+        asked = np.atleast_1d(np.asarray(times, dtype=float))
+        events = self.events
+        g = np.array(self.laws.gravity)
+        for d in np.flatnonzero(falls).tolist():
+            records = events["time"][(events["i"] == d) | (events["j"] == d)]  # in time order
+            last = np.concatenate([[self.start_time], records])[np.searchsorted(records, asked, side="right")]
+            since = asked - last
+            out[:, d] += 0.5 * g * (since * since)[:, None]
+        if self.box.periodic and not unwrapped:
+            out = self.box.wrap(out)
+        return out
 
     def frame_time(self, k):
         """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""

@@ -300,12 +300,12 @@ class SubFrame:
     def _segment(self, tc: float, a: int, k: int) -> None:
         x, y = self.at(a, tc)
         vx, vy = self.paths.velocities[a].tolist()
-        ends = self.shapes.seg_ends[k]
-        qx, qy = closest_point_on_segment(x, y, *ends)
+        ax, ay, bx, by = self.shapes.seg_ends[k]
+        qx, qy = closest_point_on_segment(x, y, ax, ay, bx, by)
         if vx * (x - qx) + vy * (y - qy) >= 0.0:  # receding
             return
         e = self._restitution(a, a, tc)
-        ux, uy = reflect_off_segment(x, y, vx, vy, *ends, e)
+        ux, uy = reflect_off_segment(x, y, vx, vy, ax, ay, bx, by, e)
         self._reflected(tc, a, x, y, vx, vy, ux, uy, e, SEGMENT, k)
 
     def _restitution(self, a: int, b: int, now: float) -> float:

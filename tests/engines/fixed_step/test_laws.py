@@ -18,7 +18,7 @@ if _numba.available():
     # Compiled now, while numba is visible: the python case of the bouncing ball runs EventDriven under the laws,
     # whose interpreted loop imports the compiled physics parts, and would import them with numba hidden (plain
     # functions that the compiled frame of the numba case then cannot call).
-    import discsim.engines.fixed_step.numba.policy  # noqa: F401
+    import discsim.engines.fixed_step.numba.policy
 
 G = 9.81
 FRAME_POLICIES = ("resolve", "revert", "separate")

@@ -192,7 +192,7 @@ def _walls(policy, pos, prev, vel, radii, masses, width, height, ref_pos, ref_t,
     for i in range(len(pos)):
         r = radii[i]
         hit = False
-        wx, wy = vel[i, 0], vel[i, 1]
+        wx = wy = 0.0
         e = 1.0
         for axis in range(2):
             size = width if axis == 0 else height
@@ -201,6 +201,7 @@ def _walls(policy, pos, prev, vel, radii, masses, width, height, ref_pos, ref_t,
             high = p > size - r and v > 0.0
             if low or high:
                 if not hit:
+                    wx, wy = vel[i, 0], vel[i, 1]
                     e = _restitution(i, i, t, e0, per_group, table, group, tc, last)
                 hit = True
                 vel[i, 0], vel[i, 1] = _reflect_wall(vel[i, 0], vel[i, 1], axis, e)
@@ -588,9 +589,10 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
     radii, masses, periodic, width, height, segments, group, blocked, filtering = scene
     all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
     gx, gy, falls = laws[0], laws[1], laws[2]
+    falling = gx != 0.0 or gy != 0.0  # (spares the free-flight loop a read of falls per disc)
     n = len(ref_pos)
     for i in range(n):  # Paths.flown and Paths.fall, then Box.wrap
-        if falls[i]:  # under gravity: along the parabola, and a new path from the frame
+        if falling and falls[i]:  # under gravity: along the parabola, and a new path from the frame
             x, y, vx, vy = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i], gx, gy)
             vel[i, 0], vel[i, 1] = vx, vy
             ref_pos[i, 0], ref_pos[i, 1] = x, y

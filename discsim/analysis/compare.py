@@ -4,9 +4,11 @@
 engine) and a run to judge (normally the fixed-step engine) from the same
 start, and reports what the second got wrong. It reads only the engine
 protocol (``discs``, ``box``, ``start_time``, ``time``, ``events``,
-``trajectory``, ``velocities``), plus two optional attributes when an engine
+``trajectory``, ``velocities``), plus optional attributes when an engine
 has them: ``dt`` (frame interval, for the frame times and the matching
-window) and ``max_overlap`` (deepest overlap it saw).
+window), ``max_overlap`` (deepest overlap it saw), and the laws of motion
+(``laws.gravity``, ``energy()``, ``dissipated``: the rebound heights and the
+energy error).
 """
 
 from __future__ import annotations

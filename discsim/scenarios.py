@@ -335,7 +335,7 @@ class Scenario:
     until: float
     name: str
     description: str
-    laws: dict = field(default_factory=dict)
+    laws: dict = field(default_factory=dict, hash=False)  # a scenario stays hashable, as before the laws
 
     @property
     def dt(self) -> float:

@@ -277,3 +277,11 @@ def test_trajectories_follow_the_parabolas_and_the_rest(every_backend):
     rest = times(sim)[-1]
     assert sim.resting.all()
     assert sim.trajectory([rest, (rest + 5.0) / 2, 5.0])[:, 0].tolist() == [sim.positions[0].tolist()] * 3
+
+
+def test_replays_of_free_flight_refuse_a_run_under_gravity():
+    sim = ds.EventDriven(ball(5.0, 5.0, 1.0), BOX, gravity=(0.0, -G)).run(until=1.0)
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.frames(sim, [0.5])
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.view(sim)

@@ -11,6 +11,7 @@ each law in turn (so a slow spell hits them alike), ``--repeats`` times (default
 * ``restitution``: no gravity, ``restitution=0.9`` with ``tc`` a hundredth of the mean free time: a cooling
   granular gas.
 * ``gravity+restitution``: both (the gas settles while it is timed).
+* ``rough``: no gravity, elastic, ``roughness=0.5``: rough discs that spin (they start without spin).
 
 Under any law but the first the pure-Python backend runs the compiled loop's source interpreted (its own loop
 knows free flight only). The issue's target: the compiled backend within 1.5x of its elastic rate under gravity
@@ -27,7 +28,7 @@ from benchutils import Column, call_fresh, format_table, machine_summary, median
 
 import discsim as ds
 
-LAWS = ("elastic", "gravity", "restitution", "gravity+restitution")
+LAWS = ("elastic", "gravity", "restitution", "gravity+restitution", "rough")
 KEYS = ["backend", "law", "n", "events", "collisions_per_s", "ratio_to_elastic", "repeats"]
 COLUMNS = [
     Column("backend", "backend", "s"),
@@ -50,6 +51,8 @@ def keywords(law: str, discs, box) -> dict:
         sigma = 2.0 * float(discs.radii.mean())
         free_time = 1.0 / (n_density * sigma * (kt * 3.14159) ** 0.5 * 2**0.5)
         out.update(restitution=0.9, tc=free_time / 100.0)
+    if law == "rough":
+        out["roughness"] = 0.5
     return out
 
 

@@ -21,6 +21,7 @@ __all__ = [
     "KIND_NAMES",
     "REMOVE",
     "SET",
+    "SPIN_DTYPE",
     "WALL",
     "Event",
     "EventKind",
@@ -99,6 +100,10 @@ EVENT_DTYPE = np.dtype(
         ("vyj", "f8"),
     ]
 )
+
+#: A rough run's spins after each collision or wall hit (``EventDriven.spin_events``): the event's time and
+#: discs (as in :data:`EVENT_DTYPE`) and the spins of ``i`` and ``j`` after it (``wj`` NaN for a wall hit).
+SPIN_DTYPE = np.dtype([("time", "f8"), ("i", "i8"), ("j", "i8"), ("wi", "f8"), ("wj", "f8")])
 
 _NAN = float("nan")
 # Rows the hot loop's tuples wait in before they move into the log's arrays together (about 0.4 MB of tuples).

@@ -1,10 +1,11 @@
-"""The laws a run uses, as the user chose them: gravity, restitution (with the TC model) and rest, validated once.
+"""The laws a run uses, as the user chose them: gravity, restitution (with the TC model), rest and roughness,
+validated once.
 
-:class:`Laws` is what every engine takes from its ``gravity=``, ``restitution=``, ``tc=`` and ``rest_speed=``
-keywords: it checks them (a :class:`~discsim.errors.DiscsimError` naming the argument and its value, before
-anything changes), stores them in a run's settings and checkpoints, and gives the compiled loops their numbers
-as one small float array (:meth:`Laws.array`) and one table (:meth:`Laws.table`). The defaults are today's
-physics, free flight and elastic collisions, bit for bit (:attr:`Laws.default`).
+:class:`Laws` is what every engine takes from its ``gravity=``, ``restitution=``, ``tc=``, ``rest_speed=`` and
+``roughness=`` keywords: it checks them (a :class:`~discsim.errors.DiscsimError` naming the argument and its
+value, before anything changes), stores them in a run's settings and checkpoints, and gives the compiled loops
+their numbers as one small float array (:meth:`Laws.array`) and one table (:meth:`Laws.table`). The defaults are
+today's physics, free flight and elastic, smooth collisions, bit for bit (:attr:`Laws.default`).
 
 Example:
     >>> laws = Laws.build(gravity=(0.0, -9.81), restitution=0.8)
@@ -26,9 +27,10 @@ from discsim.errors import InvalidArgumentError
 __all__ = ["LAW_SLOTS", "Laws"]
 
 #: Slots of :meth:`Laws.array`: gravity along x and y, the rest speed, the TC time, whether the restitution
-#: depends on the pair of groups (1.0) or is one number (0.0), and that number.
-GX, GY, REST_SPEED, TC, PER_GROUP, E = range(6)
-LAW_SLOTS = 6
+#: depends on the pair of groups (1.0) or is one number (0.0), that number, and the roughness (tangential
+#: restitution) beta.
+GX, GY, REST_SPEED, TC, PER_GROUP, E, BETA = range(7)
+LAW_SLOTS = 7
 #: The default rest speed, as a bounce height: a disc that would bounce less high than this fraction of the
 #: smallest radius comes to rest (see :class:`Laws`).
 REST_HEIGHT = 1e-3
@@ -65,22 +67,27 @@ class Laws:
             disc at rest) after an impact is below this comes to rest there (velocity zero, gravity off) until
             something hits it harder (see ``docs/laws.md``); None: the speed of a bounce
             :data:`REST_HEIGHT` times the smallest radius high.
+        roughness: the tangential coefficient of restitution ``beta`` in [-1, 1] of every collision and bounce:
+            -1, smooth (frictionless: spins never change, today's physics bit for bit); +1, perfectly rough
+            (the tangential relative velocity of the contact points reverses, energy conserved); between, the
+            tangential relative velocity is scaled by ``-beta`` (:func:`discsim.physics.laws.rough_impulse`).
     """
 
     gravity: tuple[float, float] = (0.0, 0.0)
     restitution: float | dict = 1.0
     tc: float = 0.0
     rest_speed: float | None = None
+    roughness: float = -1.0
     _pairs: tuple = field(default=(), repr=False)
 
     @classmethod
-    def build(cls, gravity=None, restitution=1.0, tc=0.0, rest_speed=None) -> Laws:
+    def build(cls, gravity=None, restitution=1.0, tc=0.0, rest_speed=None, roughness=-1.0) -> Laws:
         """Check the keywords as the engines take them and build the laws.
 
         Raises:
             InvalidArgumentError: naming the argument and value: gravity not a pair of finite numbers, a
                 restitution outside [0, 1] (or a malformed dict), a negative or non-finite ``tc`` or
-                ``rest_speed``.
+                ``rest_speed``, a roughness outside [-1, 1].
         """
         if gravity is None:
             g = (0.0, 0.0)
@@ -119,12 +126,21 @@ class Laws:
             if not (math.isfinite(rest_speed) and rest_speed > 0.0):  # 0: a disc on a floor would bounce for ever
                 msg = f"rest_speed must be None or a positive, finite number, got {rest_speed!r}"
                 raise InvalidArgumentError(msg)
-        return cls(g, e, tc, rest_speed, pairs)
+        beta = _number("roughness", roughness)
+        if not -1.0 <= beta <= 1.0:
+            msg = f"roughness must lie in [-1, 1] (-1: smooth, +1: perfectly rough), got {roughness!r}"
+            raise InvalidArgumentError(msg)
+        return cls(g, e, tc, rest_speed, beta, pairs)
 
     @property
     def default(self) -> bool:
         """True for free flight and elastic collisions: today's physics, bit for bit."""
-        return self.gravity == (0.0, 0.0) and not self._pairs and self.restitution == 1.0
+        return self.gravity == (0.0, 0.0) and not self._pairs and self.restitution == 1.0 and not self.rough
+
+    @property
+    def rough(self) -> bool:
+        """True when collisions turn the discs (``roughness`` above -1)."""
+        return self.roughness != -1.0
 
     @property
     def falls(self) -> bool:
@@ -134,7 +150,8 @@ class Laws:
     def settings(self) -> dict:
         """The laws as a run's settings store them (plain JSON: pairs of groups as ``"a,b"`` keys)."""
         e = {f"{a},{b}": v for (a, b), v in self._pairs} if self._pairs else self.restitution
-        return {"gravity": list(self.gravity), "restitution": e, "tc": self.tc, "rest_speed": self.rest_speed}
+        out = {"gravity": list(self.gravity), "restitution": e, "tc": self.tc, "rest_speed": self.rest_speed}
+        return {**out, "roughness": self.roughness} if self.rough else out
 
     @classmethod
     def from_settings(cls, settings: dict) -> Laws:
@@ -143,7 +160,9 @@ class Laws:
         if isinstance(e, dict):
             e = {tuple(int(v) for v in key.split(",")): value for key, value in e.items()}
         gravity = settings.get("gravity")
-        return cls.build(gravity, e, settings.get("tc", 0.0), settings.get("rest_speed"))
+        return cls.build(
+            gravity, e, settings.get("tc", 0.0), settings.get("rest_speed"), settings.get("roughness", -1.0)
+        )
 
     def rest_speed_for(self, radii: np.ndarray) -> float:
         """The rest speed a run of discs of ``radii`` uses (0 without gravity)."""
@@ -162,6 +181,7 @@ class Laws:
         out[TC] = self.tc
         out[PER_GROUP] = 1.0 if self._pairs else 0.0
         out[E] = 1.0 if self._pairs else float(self.restitution)  # type: ignore[arg-type]
+        out[BETA] = self.roughness
         return out
 
     def table(self, labels: np.ndarray) -> np.ndarray:

@@ -30,6 +30,7 @@ __all__ = [
     "momentum",
     "normalize_pass_through",
     "polygon",
+    "rotational_energy",
 ]
 
 #: Relative tolerance on the contact distance below which two discs count as overlapping.
@@ -131,13 +132,20 @@ class Discs:
             makes a fixed obstacle, whose velocity must be zero.
         groups: ``(N,)`` integer collision-group labels (default all 0), used by
             collision filters.
+        spins: ``(N,)`` angular velocities (radians per time unit, counter-clockwise positive), or one
+            scalar for all; finite; default zeros. They change only at collisions of rough discs
+            (``EventDriven(roughness=)``, ``docs/laws.md``).
+        inertia: ``(N,)`` moments of inertia (mass times length^2), or one scalar for all; positive;
+            default that of a uniform disc, ``m r^2 / 2`` (``numpy.inf`` for an obstacle, which must have
+            ``numpy.inf``); ``numpy.inf`` for a disc of finite mass: a rough disc that cannot turn.
 
     Attributes are read-only float64 arrays of the shapes above.
 
     Raises:
-        InvalidDiscsError: on a wrong shape, a NaN or infinite position or
-            velocity, a non-positive radius or mass, or a moving obstacle; the
-            message names the first offending disc and its value.
+        InvalidDiscsError: on a wrong shape, a NaN or infinite position,
+            velocity or spin, a non-positive radius, mass or inertia, a moving
+            obstacle or an obstacle of finite inertia; the message names the
+            argument, the first offending disc and its value.
 
     Example:
         >>> import discsim as ds
@@ -146,7 +154,7 @@ class Discs:
         (2, [0.5, 0.5])
     """
 
-    def __init__(self, positions, velocities, radii, masses=1.0, groups=None):
+    def __init__(self, positions, velocities, radii, masses=1.0, groups=None, spins=None, inertia=None):
         pos = _real_array("positions", positions)
         if pos.ndim != 2 or pos.shape[1] != 2:
             msg = f"positions must have shape (N, 2), got shape {pos.shape}"
@@ -198,11 +206,14 @@ class Discs:
                 msg = f"disc {i} has group label {int(grp[i])}, above the largest label 2**63 - 1"
                 raise InvalidDiscsError(msg)
             grp = grp.astype(np.int64)
+        spin, moment = _rotation(n, spins, inertia, rad, mass)
         self.positions = _readonly(pos)
         self.velocities = _readonly(vel)
         self.radii = _readonly(rad)
         self.masses = _readonly(mass)
         self.groups = _readonly(grp)
+        self.spins = _readonly(spin)
+        self.inertia = _readonly(moment)
 
     def __len__(self) -> int:
         return len(self.radii)
@@ -212,15 +223,21 @@ class Discs:
             return "Discs(n=0)"
         return f"Discs(n={len(self)}, radii in [{self.radii.min():g}, {self.radii.max():g}])"
 
-    def replace(self, positions=None, velocities=None) -> Discs:
-        """Return new validated discs with other positions and/or velocities."""
+    def replace(self, positions=None, velocities=None, spins=None) -> Discs:
+        """Return new validated discs with other positions, velocities and/or spins (the same inertia)."""
         return Discs(
             self.positions if positions is None else positions,
             self.velocities if velocities is None else velocities,
             self.radii,
             self.masses,
             self.groups,
+            self.spins if spins is None else spins,
+            self.inertia,
         )
+
+    def rotational_energy(self) -> float:
+        """Total rotational kinetic energy ``sum(I w^2 / 2)`` (discs of infinite inertia contribute zero)."""
+        return rotational_energy(self.spins, self.inertia)
 
     def kinetic_energy(self) -> float:
         """Total kinetic energy ``sum(m v^2 / 2)`` (obstacles contribute zero)."""
@@ -229,6 +246,36 @@ class Discs:
     def momentum(self) -> np.ndarray:
         """Total momentum ``(2,)`` of the moving discs (obstacles excluded)."""
         return momentum(self.velocities, self.masses)
+
+
+def _rotation(n: int, spins, inertia, radii: np.ndarray, masses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``spins`` and ``inertia`` of ``Discs`` checked, as ``(N,)`` float arrays (defaults filled in)."""
+    spin = np.zeros(n) if spins is None else _as_float_array("spins", spins, (n,))
+    bad = ~np.isfinite(spin)
+    if bad.any():
+        i = _first_bad(bad)
+        msg = f"spins: disc {i} has a non-finite spin {float(spin[i])!r}"
+        raise InvalidDiscsError(msg)
+    if inertia is None:
+        return spin, 0.5 * masses * radii * radii  # inf for an obstacle
+    moment = _as_float_array("inertia", inertia, (n,))
+    bad = ~(moment > 0)  # also catches NaN
+    if bad.any():
+        i = _first_bad(bad)
+        msg = f"inertia: disc {i} has inertia {float(moment[i])!r}; moments of inertia must be positive"
+        raise InvalidDiscsError(msg)
+    bad = np.isinf(masses) & np.isfinite(moment)
+    if bad.any():
+        i = _first_bad(bad)
+        msg = f"inertia: disc {i} is an obstacle (mass inf) but has inertia {float(moment[i])!r}; it must be inf"
+        raise InvalidDiscsError(msg)
+    return spin, moment
+
+
+def rotational_energy(spins: np.ndarray, inertia: np.ndarray) -> float:
+    """Sum of ``I w^2 / 2`` over discs of finite inertia."""
+    finite = np.isfinite(inertia)
+    return float(0.5 * np.dot(inertia[finite], spins[finite] ** 2))
 
 
 def kinetic_energy(velocities: np.ndarray, masses: np.ndarray) -> float:

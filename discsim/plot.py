@@ -22,7 +22,7 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import animation
-from matplotlib.collections import EllipseCollection, PatchCollection
+from matplotlib.collections import EllipseCollection, LineCollection, PatchCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
@@ -85,18 +85,8 @@ def _arrows(ax, positions, velocities, scale_time, colours, zorder=4):
     """Velocity arrows drawn to scale: an arrow is where the disc gets in ``scale_time``."""
     if not len(positions) or scale_time <= 0:
         return None
-    return ax.quiver(
-        positions[:, 0],
-        positions[:, 1],
-        velocities[:, 0] * scale_time,
-        velocities[:, 1] * scale_time,
-        color=colours,
-        angles="xy",
-        scale_units="xy",
-        scale=1.0,
-        width=0.004,
-        zorder=zorder,
-    )
+    x, y, u, v = positions[:, 0], positions[:, 1], velocities[:, 0] * scale_time, velocities[:, 1] * scale_time
+    return ax.quiver(x, y, u, v, color=colours, angles="xy", scale_units="xy", scale=1.0, width=0.004, zorder=zorder)
 
 
 def _arrow_time(radii: np.ndarray, velocities: np.ndarray) -> float:
@@ -104,8 +94,8 @@ def _arrow_time(radii: np.ndarray, velocities: np.ndarray) -> float:
     return 4.0 * float(radii.max()) / speed if speed > 0 else 0.0
 
 
-def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
-    """Draw discs as circles to scale, with velocity arrows.
+def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True, marks: bool | None = None):
+    """Draw discs as circles to scale, with velocity arrows (and a mark on each disc that shows its turning).
 
     Args:
         sim_or_discs: an engine (drawn at its current ``time``) or a
@@ -114,6 +104,8 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
         box: the box to outline; default the engine's box (none for bare discs).
         arrows: draw velocity arrows; the longest is four radii of the largest
             disc long, the others to the same scale.
+        marks: draw a radius of each disc at its angle (``sim.angles``; 0, along +x, for bare discs), which
+            shows its turning from one plot to the next; None: when any disc spins or has turned.
 
     Returns:
         The matplotlib ``Axes``.
@@ -134,6 +126,10 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True):
     ax = _axes(ax)
     colours = _disc_colours(discs.masses)
     _circles(ax, positions, discs.radii, colours)
+    angles = getattr(sim_or_discs, "angles", np.zeros(len(discs)))  # an engine's; bare discs have not turned
+    if marks or (marks is None and (getattr(sim_or_discs, "spins", discs.spins).any() or angles.any())):
+        tips = positions + discs.radii[:, None] * np.column_stack([np.cos(angles), np.sin(angles)]).reshape(-1, 2)
+        ax.add_collection(LineCollection(list(np.stack([positions, tips], axis=1)), colors="k", zorder=3))
     if arrows:
         quiver = _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
         if quiver is not None and box is not None:  # arrows end at the walls, as the discs do

@@ -6,6 +6,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import math
+
 import matplotlib.collections
 import matplotlib.pyplot as plt
 import matplotlib.quiver
@@ -56,6 +58,18 @@ def test_plot_state_of_discs_and_of_an_engine(tmp_path):
     assert plot.plot_state(sim, ax=given) is given
     assert "t = 0.5" in given.get_title()
     assert_not_blank(plot.save_figure(fig, tmp_path / "sim.png"))
+
+
+def test_plot_state_marks_the_turning_of_spinning_discs():
+    discs = ds.Discs([[2.0, 2.0], [6.0, 2.0]], [[0.0, 0.0], [0.0, 0.0]], radii=1.0, spins=[math.pi / 2, 0.0])
+    sim = ds.EventDriven(discs, ds.Box(8.0, 4.0)).run(until=1.0)
+    (marks,) = [c for c in plot.plot_state(sim).collections if isinstance(c, matplotlib.collections.LineCollection)]
+    # Disc 0 turned a quarter turn: its mark points up; disc 1 did not turn: along +x.
+    np.testing.assert_allclose(marks.get_segments(), [[[2.0, 2.0], [2.0, 3.0]], [[6.0, 2.0], [7.0, 2.0]]], atol=1e-12)
+    still = ds.Discs([[2.0, 2.0]], [[0.0, 0.0]], radii=1.0)  # nothing turns: no marks unless asked for
+    lines = [c for c in plot.plot_state(still).collections if isinstance(c, matplotlib.collections.LineCollection)]
+    assert lines == []
+    assert len(plot.plot_state(still, marks=True).collections) == len(plot.plot_state(still).collections) + 1
 
 
 def test_plot_state_clips_velocity_arrows_at_the_box():

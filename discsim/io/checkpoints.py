@@ -104,11 +104,15 @@ def _discs_arrays(prefix: str, discs: Discs) -> dict[str, np.ndarray]:
         f"{prefix}.radii": discs.radii,
         f"{prefix}.masses": discs.masses,
         f"{prefix}.groups": discs.groups,
+        f"{prefix}.spins": discs.spins,
+        f"{prefix}.inertia": discs.inertia,
     }
 
 
 def _discs_from(arrays: dict, prefix: str) -> Discs:
-    return Discs(*(arrays[f"{prefix}.{name}"] for name in ("positions", "velocities", "radii", "masses", "groups")))
+    names = ("positions", "velocities", "radii", "masses", "groups")
+    turning = {name: arrays.get(f"{prefix}.{name}") for name in ("spins", "inertia")}  # absent: files before spins
+    return Discs(*(arrays[f"{prefix}.{name}"] for name in names), **turning)
 
 
 def checkpoint_info(path) -> dict:

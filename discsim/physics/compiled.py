@@ -35,6 +35,7 @@ __all__ = [
     "predict_y",
     "reflect",
     "reflect_off_segment",
+    "rough_impulse",
     "segment_time_of_impact",
     "wall_time",
 ]
@@ -50,6 +51,7 @@ _SOURCES = (
     dynamics._falling_segment_time,
     *(getattr(dynamics, name) for name in DYNAMICS),
     *(getattr(laws, name) for name in LAWS),
+    laws.rough_impulse,
     pairs.predict,
     pairs.resolve,
     boundaries.predict_x,
@@ -62,6 +64,7 @@ _NAMES = {
     "minimum_image_1d": model.minimum_image_1d,
     **{name: getattr(dynamics, name) for name in DYNAMICS},
     **{name: getattr(laws, name) for name in LAWS},
+    "rough_impulse": laws.rough_impulse,
     "pair_predict": pairs.predict,
     "pair_resolve": pairs.resolve,
     "predict_x": boundaries.predict_x,
@@ -111,6 +114,7 @@ collide = _parts["collide"]
 reflect = _parts["reflect"]
 closest_point_on_segment = _parts["closest_point_on_segment"]
 reflect_off_segment = _parts["reflect_off_segment"]
+rough_impulse = _parts["rough_impulse"]
 pair_predict = _parts["pair_predict"]
 pair_resolve = _parts["pair_resolve"]
 predict_x = _parts["predict_x"]

@@ -21,6 +21,7 @@ from discsim.engines.event_driven.protocol import BackendClass
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.engines.event_driven.stops import RunStops
+from discsim.engines.event_driven.turning import Turning
 from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.events import KIND_NAMES, Event
 from discsim.laws import Laws
@@ -37,7 +38,7 @@ BACKENDS: dict[str, BackendClass] = {"python": PythonBackend, "numba": NumbaBack
 
 
 @register_engine
-class EventDriven(RunStops, Engine):
+class EventDriven(Turning, RunStops, Engine):
     """Exact event-driven simulation of hard discs (PIC): elastic by default, or under gravity, with restitution.
 
     Args:
@@ -81,6 +82,11 @@ class EventDriven(RunStops, Engine):
         rest_speed: under gravity, the speed below which a bounce off a support ends in rest (velocity zero,
             gravity off, until hit harder); None: the speed of a bounce ``1e-3`` of the smallest radius high
             (:class:`~discsim.laws.Laws`).
+        roughness: the tangential coefficient of restitution ``beta`` in [-1, 1] of every collision and bounce:
+            -1 (the default) smooth, today's physics bit for bit (spins never change); +1 perfectly rough
+            (energy conserving); between, energy lost. The impulse at the contact point turns the discs
+            (``discs.spins``, ``discs.inertia``; :attr:`spins`, :attr:`angles`, :attr:`spin_events`); walls and
+            segments are as rough as the discs (``docs/laws.md``).
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
@@ -123,8 +129,9 @@ class EventDriven(RunStops, Engine):
         restitution=1.0,
         tc: float = 0.0,
         rest_speed: float | None = None,
+        roughness: float = -1.0,
     ):
-        laws = Laws.build(gravity, restitution, tc, rest_speed)
+        laws = Laws.build(gravity, restitution, tc, rest_speed, roughness)
         self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend, laws)
         self._backend.start()
 
@@ -259,6 +266,11 @@ class EventDriven(RunStops, Engine):
         if not self.laws.default:  # what the laws keep: the energy lost, and which kept discs are at rest
             state.dissipated = old.dissipated
             state.resting[: len(keep)] = old.resting()[keep]
+        spins, angles = old.turning()  # the kept discs keep turning (added ones start with their own spins)
+        state.spins[: len(keep)], state.angles[: len(keep)] = spins[keep], angles[keep]
+        spin_log = getattr(old, "spin_log", None)
+        if spin_log and hasattr(backend, "spin_log"):
+            backend.spin_log = spin_log
         if last is not None:
             state.last_time, state.last_kind, state.last_i, state.last_j = last
         if box.periodic and len(keep):

@@ -87,4 +87,6 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
         queue_stamp=empty_queue,
         resting=np.zeros(n, dtype=np.int64),
         last_collision=np.full(n, -math.inf),
+        spins=np.array(discs.spins),
+        angles=np.zeros(n),
     )

@@ -72,6 +72,9 @@ class Backend(Protocol):
     def resting(self) -> np.ndarray:
         """``(N,)`` bool: the discs at rest under gravity (caller's numbering)."""
 
+    def turning(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(spins, angles)``: each disc's spin and angle at ``time``, ``(N,)`` each (caller's numbering)."""
+
     def disc_counts(self) -> np.ndarray:
         """``(N,)`` int64: each disc's collision counter (its collisions, wall hits and edits so far; obstacles'
         stay put), a new array in the caller's numbering. O(N): the jam guard's, once per suspected jam."""

@@ -19,8 +19,9 @@ __all__ = ["EventDrivenState"]
 
 @dataclass(eq=False)
 class EventDrivenState(EngineState):
-    """Everything an event-driven run needs to continue bit for bit (version 2: version 1 plus the laws' fields,
-    which a version-1 state, from before the laws, reads as their defaults).
+    """Everything an event-driven run needs to continue bit for bit (version 3: version 1 plus the laws' fields
+    (version 2) and the discs' turning (version 3); an older state reads the fields it lacks as their defaults:
+    no disc at rest, no collision recorded, spins and angles zero).
 
     Per-disc arrays are indexed in the caller's numbering (as ``discs``); disc
     indices inside arrays (partners, cell members, queue owners) too. Times in
@@ -57,12 +58,16 @@ class EventDrivenState(EngineState):
         resting ``(N,)`` int64: 1 for a disc at rest under gravity (velocity zero, gravity off).
         last_collision ``(N,)``: each disc's last collision time (absolute; ``-inf`` if none or unrecorded),
             kept for the TC model only.
+        spins ``(N,)``: each disc's angular velocity (radians per time unit, counter-clockwise positive); constant
+            between its collisions, changed only by those of rough discs (``roughness`` above -1).
+        angles ``(N,)``: each disc's angle at ``time`` (radians, counter-clockwise, 0 at the start): the
+            orientation a viewer's mark shows; no law reads it.
 
     Scalars of the laws: dissipated (kinetic energy lost in collisions and by discs coming to rest),
     rests (discs put to rest).
     """
 
-    VERSION = 2
+    VERSION = 3
 
     time: float
     epoch: float
@@ -102,6 +107,8 @@ class EventDrivenState(EngineState):
     last_collision: np.ndarray = None  # type: ignore[assignment]  # None: no collision recorded
     dissipated: float = 0.0
     rests: int = 0
+    spins: np.ndarray = None  # type: ignore[assignment]  # None: zeros (filled in by __post_init__)
+    angles: np.ndarray = None  # type: ignore[assignment]  # None: zeros
 
     def __post_init__(self) -> None:
         n = len(self.order)
@@ -109,14 +116,22 @@ class EventDrivenState(EngineState):
             self.resting = np.zeros(n, dtype=np.int64)
         if self.last_collision is None:
             self.last_collision = np.full(n, -np.inf)
+        if self.spins is None:
+            self.spins = np.zeros(n)
+        if self.angles is None:
+            self.angles = np.zeros(n)
 
     @classmethod
     def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int):
-        """As :meth:`EngineState.from_arrays`; a version-1 state (before the laws) gets their defaults."""
+        """As :meth:`EngineState.from_arrays`; a version-1 state (before the laws) gets their defaults, a version-1
+        or 2 state (before spins) spins and angles zero."""
+        n = len(arrays.get("order", ()))
         if version == 1:
-            n = len(arrays.get("order", ()))
             arrays = {**arrays, "resting": np.zeros(n, dtype=np.int64), "last_collision": np.full(n, -np.inf)}
             scalars = {**scalars, "dissipated": 0.0, "rests": 0}
+            version = 2
+        if version == 2:
+            arrays = {**arrays, "spins": np.zeros(n), "angles": np.zeros(n)}
             version = cls.VERSION
         return super().from_arrays(scalars, arrays, version)
 
@@ -149,6 +164,8 @@ class EventDrivenState(EngineState):
             "order": ((n,), "i"),
             "resting": ((n,), "i"),
             "last_collision": ((n,), "f"),
+            "spins": ((n,), "f"),
+            "angles": ((n,), "f"),
         }
         q = np.shape(self.queue_owner)
         shapes.update(
@@ -171,7 +188,7 @@ class EventDrivenState(EngineState):
         for field in ("time", "epoch", "virial", "max_overlap", "last_time"):
             if not isinstance(getattr(self, field), (int, float)) or not np.isfinite(getattr(self, field)):
                 fail(field, f"expected a finite number, got {getattr(self, field)!r}")
-        for field in ("ref_positions", "velocities", "ref_times", "queue_time"):
+        for field in ("ref_positions", "velocities", "ref_times", "queue_time", "spins", "angles"):
             bad = ~np.isfinite(getattr(self, field))
             if bad.any():
                 fail(field, f"non-finite value {getattr(self, field)[bad].flat[0]!r}")

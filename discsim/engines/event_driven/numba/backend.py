@@ -18,7 +18,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numba.reads import CompiledReads
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
-from discsim.events import EVENT_DTYPE, EventKind, EventLog
+from discsim.events import EVENT_DTYPE, SPIN_DTYPE, EventKind, EventLog
 from discsim.laws import Laws
 from discsim.physics import dynamics
 from discsim.scene import Scene
@@ -127,6 +127,8 @@ class NumbaBackend(CompiledReads):
         self._seg_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         self._seg_idx = np.array([k for s in near for k in s], dtype=np.int64)
         self._events: tuple[np.ndarray, ...] | None = None  # the log buffer, made on the first recorded run
+        #: A rough run's spins after each logged event, in chunks of :data:`~discsim.events.SPIN_DTYPE` rows.
+        self.spin_log: list[np.ndarray] = []
 
     # --- the protocol --------------------------------------------------------------------
     def start(self, state: EventDrivenState | None = None) -> None:
@@ -207,6 +209,10 @@ class NumbaBackend(CompiledReads):
         ints[lp.I_RESTS] = state.rests
         self._rest = state.resting[order].astype(np.int8)
         self._tlast = state.last_collision[order].astype(np.float64)
+        # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
+        self._rot = np.column_stack(
+            [state.spins[order], discs.inertia[order], state.angles[order], np.full(n, float(state.time))]
+        ).reshape(n, 4)
         scene = self.scene
         self._egroup = scene.group[order].astype(np.int64) if len(scene) else np.zeros(1, dtype=np.int64)
         self._etab = self.laws.table(np.unique(scene.discs.groups))
@@ -225,6 +231,7 @@ class NumbaBackend(CompiledReads):
             return out
 
         rec, ints, floats = self._rec, self._ints, self._floats
+        spins, angles = self.turning()
         members = np.zeros(n, dtype=np.int64)
         sizes = np.zeros(len(self.grid), dtype=np.int64)
         lp.unlink(self._head, self._nxt, members, sizes)
@@ -276,6 +283,8 @@ class NumbaBackend(CompiledReads):
             last_collision=caller(self._tlast),
             dissipated=float(floats[lp.F_LOST]),
             rests=int(ints[lp.I_RESTS]),
+            spins=spins,
+            angles=angles,
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
@@ -298,6 +307,7 @@ class NumbaBackend(CompiledReads):
                 np.empty(LOG_ROWS, dtype=np.int64),
                 np.empty(LOG_ROWS, dtype=np.int64),
                 np.empty((LOG_ROWS, 8)),
+                np.empty((LOG_ROWS, 2)),
             )
         events: tuple[np.ndarray, ...] = self._events if self._events is not None and recording else _NO_EVENTS
         args = self._loop_args()
@@ -318,6 +328,8 @@ class NumbaBackend(CompiledReads):
                     done += k
                     if logged and log is not None:  # logged > 0 only when recording
                         log.extend(_records(events, logged))
+                        if self.laws.rough:
+                            self.spin_log.append(_spin_records(events, logged))
                     if crossings >= 0:
                         crossings -= crossed
                     if why != lp.MORE or interrupted[0]:
@@ -370,6 +382,7 @@ class NumbaBackend(CompiledReads):
             self._rec, self._count, self._order, self._images, self._kept_partner, self._kept_stamp,
             self._cell, self._head, self._nxt,
             *self._geometry(), *self._filter(), *self._queue(), self._floats, self._etab, self._egroup, self._tlast,
+            self._rot,
         )  # fmt: skip
 
 
@@ -379,12 +392,13 @@ _NO_EVENTS = (
     np.empty(0, dtype=np.int64),
     np.empty(0, dtype=np.int64),
     np.empty((0, 8)),
+    np.empty((0, 2)),
 )
 
 
 def _records(events, k: int) -> np.ndarray:
     """The first ``k`` rows of the loop's log buffer as an :data:`~discsim.events.EVENT_DTYPE` array."""
-    ev_t, ev_kind, ev_i, ev_j, ev_f = events
+    ev_t, ev_kind, ev_i, ev_j, ev_f, _ = events
     out = np.empty(k, dtype=EVENT_DTYPE)
     out["time"] = ev_t[:k]
     out["kind"] = ev_kind[:k]
@@ -392,4 +406,16 @@ def _records(events, k: int) -> np.ndarray:
     out["j"] = ev_j[:k]
     for c, name in enumerate(("xi", "yi", "vxi", "vyi", "xj", "yj", "vxj", "vyj")):
         out[name] = ev_f[:k, c]
+    return out
+
+
+def _spin_records(events, k: int) -> np.ndarray:
+    """The spins of the first ``k`` rows of the loop's log buffer as :data:`~discsim.events.SPIN_DTYPE` rows."""
+    ev_t, _, ev_i, ev_j, _, ev_w = events
+    out = np.empty(k, dtype=SPIN_DTYPE)
+    out["time"] = ev_t[:k]
+    out["i"] = ev_i[:k]
+    out["j"] = ev_j[:k]
+    out["wi"] = ev_w[:k, 0]
+    out["wj"] = ev_w[:k, 1]
     return out

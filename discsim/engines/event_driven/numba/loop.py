@@ -20,7 +20,10 @@ only the data structures differ:
 - the queue, one pending event per disc (``qt``, ``qk``, ``qo``, ``qs``: time, kind, other, stamp) and a
   binary heap of blocks of 16 discs ordered by their earliest ``(time, owner)``, popping in the same order as
   the Python backend's queues;
-- counters and scalars in two small arrays, ``ints`` and ``floats`` (the ``I_*`` and ``F_*`` slots).
+- counters and scalars in two small arrays, ``ints`` and ``floats`` (the ``I_*`` and ``F_*`` slots);
+- ``rot`` ``(N, 4)`` float64, each disc's turning: its spin, moment of inertia, and its angle at an absolute time
+  (``W``, ``INERTIA``, ``ANGLE``, ``ANGLE_T``); only ``run_events`` takes it, and only its rough branches
+  (``LAWS``, roughness above -1) write it: spins change at collisions of rough discs only.
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ from discsim._compiled import inline, jit, prefetch
 from discsim.engines.event_driven.numba import blocks
 from discsim.engines.event_driven.numba.blocks import BLOCK, BLOCK_SHIFT, discard, push, reblock  # noqa: F401
 from discsim.events import EventKind
-from discsim.laws import GX, GY, PER_GROUP, REST_SPEED, TC, E
+from discsim.laws import BETA, GX, GY, PER_GROUP, REST_SPEED, TC, E
 from discsim.physics.compiled import (
     advance,
     closest_point_on_segment,
@@ -44,6 +47,7 @@ from discsim.physics.compiled import (
     predict_y,
     reflect,
     reflect_off_segment,
+    rough_impulse,
     segment_time_of_impact,
 )
 from discsim.physics.sources.boundaries import MINUS_X, MINUS_Y, PLUS_X, PLUS_Y
@@ -54,6 +58,8 @@ COLLISION, WALL, CROSSING, SEGMENT = (
 )
 # Columns of a disc's row in ``rec``.
 X, Y, VX, VY, T, R, M, KEPT = 0, 1, 2, 3, 4, 5, 6, 7
+# Columns of a disc's row in ``rot``: spin, moment of inertia, angle at the absolute time ``ANGLE_T``.
+W, INERTIA, ANGLE, ANGLE_T = 0, 1, 2, 3
 # Slots of ``ints``.
 I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS = range(12)
 N_INTS = 12
@@ -220,6 +226,19 @@ def restitution(i, j, now, law, etab, egroup, tlast):
     return e
 
 
+@inline
+def turn(k, now, rot):
+    """Bring disc ``k``'s angle to the absolute time ``now`` (its spin has been constant since its angle's time)."""
+    rot[k, ANGLE] += rot[k, W] * (now - rot[k, ANGLE_T])
+    rot[k, ANGLE_T] = now
+
+
+@inline
+def spin_energy(inertia, w):
+    """``I w^2 / 2``; 0 for a disc that cannot turn (``I`` inf: its spin never changes)."""
+    return 0.0 if inertia == INF else 0.5 * inertia * w * w
+
+
 @jit
 def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
@@ -377,13 +396,14 @@ def run_events(
     rec, count, order, images, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
     seg, seg_start, seg_idx, group, blocked, rest,
-    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats, etab, egroup, tlast,
-    ev_t, ev_kind, ev_i, ev_j, ev_f,
+    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats, etab, egroup, tlast, rot,
+    ev_t, ev_kind, ev_i, ev_j, ev_f, ev_w,
 ):  # fmt: skip
     """Process events with times <= ``until``: the Python backend's ``process_events``, compiled.
 
     Stops after ``limit`` physical events (-1: no limit), ``crossings`` cell crossings (-1: none),
-    ``budget`` pops, or when the log buffer (``ev_*``, written when ``recording``) is full.
+    ``budget`` pops, or when the log buffer (``ev_*``, written when ``recording``) is full; a rough run
+    (``LAWS``, roughness above -1) also logs the spins after each event in ``ev_w`` (disc ``i``'s, ``j``'s).
 
     Returns:
         ``(done, crossed, logged, why)``: physical events, crossings, records written, and
@@ -396,6 +416,10 @@ def run_events(
     if LAWS:
         gx, gy = law[GX], law[GY]
     gravity = LAWS and (gx != 0.0 or gy != 0.0)
+    beta = -1.0
+    if LAWS:
+        beta = law[BETA]
+    rough = LAWS and beta != -1.0
     n_coll = n_wall = n_cross = n_stale = 0
     done = 0
     logged = 0
@@ -460,6 +484,17 @@ def run_events(
                 xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic, e
             )
             moved_j = mj != INF  # obstacles never move, and their counter never changes
+            if LAWS and rough:  # the tangential impulse at the contact turns both (at right angles to the normal one)
+                turn(i, t + epoch, rot)
+                turn(j, t + epoch, rot)
+                wi, wj = rot[i, W], rot[j, W]
+                txi, tyi, txj, tyj, rot[i, W], rot[j, W] = rough_impulse(
+                    dx, dy, vxi, vyi, vxj, vyj, wi, wj, rec[i, R], rec[j, R], mi, mj, rot[i, INERTIA], rot[j, INERTIA],
+                    beta,
+                )  # fmt: skip
+                uxi, uyi, uxj, uyj = uxi + (txi - vxi), uyi + (tyi - vyi), uxj + (txj - vxj), uyj + (tyj - vyj)
+                floats[F_LOST] += spin_energy(rot[i, INERTIA], wi) - spin_energy(rot[i, INERTIA], rot[i, W])
+                floats[F_LOST] += spin_energy(rot[j, INERTIA], wj) - spin_energy(rot[j, INERTIA], rot[j, W])
             i_falls = gravity and rest[i] == 0  # (owners are never obstacles)
             if gravity and i_falls != (moved_j and rest[j] == 0):
                 # One falls onto a support (an obstacle or a disc at rest): too slow a bounce and it rests there.
@@ -482,7 +517,7 @@ def run_events(
                     rest[i] = 0
                     if moved_j:
                         rest[j] = 0
-            if LAWS and (e != 1.0 or gravity):
+            if LAWS and (e != 1.0 or gravity or rough):
                 lost = 0.5 * mi * ((vxi * vxi + vyi * vyi) - (uxi * uxi + uyi * uyi))
                 if moved_j:
                     lost += 0.5 * mj * ((vxj * vxj + vyj * vyj) - (uxj * uxj + uyj * uyj))
@@ -508,6 +543,8 @@ def run_events(
                 ev_j[logged] = order[j]
                 ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, uxi, uyi
                 ev_f[logged, 4], ev_f[logged, 5], ev_f[logged, 6], ev_f[logged, 7] = xj, yj, uxj, uyj
+                if LAWS and rough:
+                    ev_w[logged, 0], ev_w[logged, 1] = rot[i, W], rot[j, W]
                 logged += 1
             # The pair cannot meet again before one of them changes course, unless one falls and the other
             # does not (a ball bouncing on a disc at rest comes back): then neither is excluded.
@@ -543,6 +580,22 @@ def run_events(
             else:
                 vxi, vyi = reflect(vxi, vyi, other, e)
                 exclude = -1
+            if LAWS and rough:  # the wall (or segment) is as rough as the discs: the same law against an infinite mass
+                if kind == SEGMENT:
+                    sx0, sy0, sx1, sy1 = seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
+                    qx, qy = closest_point_on_segment(xi, yi, sx0, sy0, sx1, sy1)
+                    cxw, cyw = qx - xi, qy - yi  # from the centre towards the contact point
+                elif other == 0:
+                    cxw, cyw = (-1.0 if xi < 0.5 * width else 1.0), 0.0
+                else:
+                    cxw, cyw = 0.0, (-1.0 if yi < 0.5 * height else 1.0)
+                turn(i, t + epoch, rot)
+                wi = rot[i, W]
+                txi, tyi, _, _, rot[i, W], _ = rough_impulse(
+                    cxw, cyw, wx, wy, 0.0, 0.0, wi, 0.0, rec[i, R], 0.0, rec[i, M], INF, rot[i, INERTIA], INF, beta
+                )
+                vxi, vyi = vxi + (txi - wx), vyi + (tyi - wy)
+                floats[F_LOST] += spin_energy(rot[i, INERTIA], wi) - spin_energy(rot[i, INERTIA], rot[i, W])
             if gravity:  # too slow a bounce off a floor (a support with gravity into it): the disc rests
                 if kind == SEGMENT:
                     sx0, sy0, sx1, sy1 = seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
@@ -557,7 +610,7 @@ def run_events(
                     vxi = vyi = 0.0
                     rest[i] = 1
                     ints[I_RESTS] += 1
-            if LAWS and (e != 1.0 or gravity):
+            if LAWS and (e != 1.0 or gravity or rough):
                 floats[F_LOST] += 0.5 * rec[i, M] * ((wx * wx + wy * wy) - (vxi * vxi + vyi * vyi))
             if LAWS and law[TC] > 0.0:
                 tlast[i] = t + epoch
@@ -572,6 +625,8 @@ def run_events(
                 ev_j[logged] = -1
                 ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, vxi, vyi
                 ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
+                if LAWS and rough:
+                    ev_w[logged, 0], ev_w[logged, 1] = rot[i, W], np.nan
                 logged += 1
             predict(
                 i, t, exclude, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,

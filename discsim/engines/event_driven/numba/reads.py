@@ -23,6 +23,7 @@ class CompiledReads:
     _order: np.ndarray
     _images: np.ndarray
     _rest: np.ndarray
+    _rot: np.ndarray
     _count: np.ndarray
     _qt: np.ndarray
     _kept_partner: np.ndarray
@@ -90,6 +91,12 @@ class CompiledReads:
     def dissipated(self) -> float:
         """Kinetic energy lost in collisions (restitution) and by discs coming to rest, since the start."""
         return float(self._floats[self._lp.F_LOST])
+
+    def turning(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(spins, angles)``, each ``(N,)`` at ``time`` in the caller's numbering (new arrays)."""
+        rot, rank = self._rot, self._rank()
+        angles = rot[:, 2] + rot[:, 0] * (self.time - rot[:, 3])
+        return rot[rank, 0].copy(), angles[rank]
 
     def resting(self) -> np.ndarray:
         """``(N,)`` bool: the discs at rest (under gravity), in the caller's numbering."""

@@ -165,6 +165,8 @@ class PythonBackend:
             i, j = int(rank[state.last_i]), (int(rank[state.last_j]) if state.last_j >= 0 else state.last_j)
             self._last = (state.last_time, state.last_kind, i, j)
         self._predict, self._predictions = make_predictor(self, state.predictions, cells, state.cell[order].tolist())
+        # Spins never change in this loop (smooth discs: EventDriven's rule): the angles at load time suffice.
+        self._spins, self._angles, self._angle_time = state.spins.copy(), state.angles.copy(), state.time
 
     def export(self) -> EventDrivenState:
         """The run state, in the caller's numbering (new arrays)."""
@@ -226,6 +228,8 @@ class PythonBackend:
             queue_stamp=np.array([p[2] for _, _, p in pending], dtype=np.int64),
             resting=np.zeros(n, dtype=np.int64),  # this loop runs the default laws only (EventDriven's rule)
             last_collision=np.full(n, -np.inf),
+            spins=self._spins.copy(),
+            angles=self.turning()[1],
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
@@ -313,6 +317,11 @@ class PythonBackend:
     def dissipated(self) -> float:
         """Kinetic energy lost: none (this loop runs the default laws only: elastic, no gravity)."""
         return 0.0
+
+    def turning(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(spins, angles)``, each ``(N,)`` at ``time`` in the caller's numbering (new arrays): the spins as
+        loaded (smooth discs never change them), the angles turned on since."""
+        return self._spins.copy(), self._angles + self._spins * (self.time - self._angle_time)
 
     def resting(self) -> np.ndarray:
         """``(N,)`` bool: no disc rests without gravity."""

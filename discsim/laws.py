@@ -116,8 +116,8 @@ class Laws:
             raise InvalidArgumentError(msg)
         if rest_speed is not None:
             rest_speed = _number("rest_speed", rest_speed)
-            if not (math.isfinite(rest_speed) and rest_speed >= 0.0):
-                msg = f"rest_speed must be None or a finite number >= 0, got {rest_speed!r}"
+            if not (math.isfinite(rest_speed) and rest_speed > 0.0):  # 0: a disc on a floor would bounce for ever
+                msg = f"rest_speed must be None or a positive, finite number, got {rest_speed!r}"
                 raise InvalidArgumentError(msg)
         return cls(g, e, tc, rest_speed, pairs)
 

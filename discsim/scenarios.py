@@ -1,13 +1,14 @@
 """Ready-made initial conditions.
 
 :func:`random_gas` makes seeded, non-overlapping gases at a chosen packing
-fraction. The study's four PIT failure cases and other set pieces live here too.
+fraction. The study's four PIT failure cases, the cases under the laws of motion of issue 27
+(:func:`law_cases`: a ball bouncing to rest) and other set pieces live here too.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -17,8 +18,10 @@ from discsim.model import Box, Discs
 __all__ = [
     "Scenario",
     "billiard_break",
+    "bouncing_ball",
     "delay",
     "head_on",
+    "law_cases",
     "missed_collision",
     "multiple_collisions",
     "newtons_cradle",
@@ -317,6 +320,8 @@ class Scenario:
         until: the horizon (time units); a whole number of frames.
         name: a short identifier, e.g. ``"missed_collision"``.
         description: one or two sentences on what happens and what PIT gets wrong.
+        laws: the keywords of the laws of motion both engines take (``gravity=``, ``restitution=``; pass
+            them as ``**case.laws``); empty: free flight and elastic collisions.
 
     Example:
         >>> case = missed_collision()
@@ -330,6 +335,7 @@ class Scenario:
     until: float
     name: str
     description: str
+    laws: dict = field(default_factory=dict, hash=False)  # a scenario stays hashable, as before the laws
 
     @property
     def dt(self) -> float:
@@ -461,6 +467,49 @@ def study_cases() -> list[Scenario]:
         ['missed_collision', 'wrong_direction', 'multiple_collisions', 'delay']
     """
     return [missed_collision(), wrong_direction(), multiple_collisions(), delay()]
+
+
+def bouncing_ball(restitution: float = 0.8, height: float = 4.0, gravity: float = 9.81) -> Scenario:
+    """A ball dropped onto the floor, bouncing to rest under gravity with restitution (issue 27).
+
+    One disc of radius 0.5, its bottom ``height`` above the floor of a 4 x 7 box, at rest, under
+    ``gravity=(0, -gravity)`` with ``restitution``. Exactly (PIC), it hits the floor at
+    ``t0 = sqrt(2 h / g)`` and bounce ``k`` rises ``e^(2k) h``, the flights ``2 e^k t0`` long: it comes to rest
+    at ``t0 (1 + e) / (1 - e)`` (9 t0 = 8.13 at the defaults), after the infinitely many bounces a geometric
+    series sums (EventDriven puts it to rest at the bounce below its rest speed). PIT (30 frames per unit
+    time) answers each bounce at the first frame below the floor, so its bounce times and heights drift from
+    the series, and once a bounce lasts less than a frame the ball jitters on the floor instead of resting.
+
+    Example:
+        >>> case = bouncing_ball()
+        >>> case.laws, case.frame_rate, case.until
+        ({'gravity': (0.0, -9.81), 'restitution': 0.8}, 30.0, 10.0)
+    """
+    r = 0.5
+    discs = Discs([[2.0, r + height]], [[0.0, 0.0]], radii=r)
+    return Scenario(
+        discs,
+        Box(4.0, 7.0),
+        frame_rate=30.0,
+        until=10.0,
+        name="bouncing_ball",
+        description=(
+            "A ball bounces to rest under gravity with restitution: PIT answers each bounce below the floor, "
+            "so its bounce times and heights drift from the exact geometric series, and it jitters on the "
+            "floor instead of resting."
+        ),
+        laws={"gravity": (0.0, -float(gravity)), "restitution": float(restitution)},
+    )
+
+
+def law_cases() -> list[Scenario]:
+    """The cases that compare PIT against PIC under the laws of issue 27 (run both with ``**case.laws``).
+
+    Example:
+        >>> [case.name for case in law_cases()]
+        ['bouncing_ball']
+    """
+    return [bouncing_ball()]
 
 
 def head_on(m1: float = 1.0, m2: float = 1.0) -> Scenario:

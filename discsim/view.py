@@ -85,6 +85,13 @@ class _Span:
 
 def _from_engine(sim, label: str | None) -> _Run:
     name = type(sim).__name__
+    laws = getattr(sim, "laws", None)
+    if laws is not None and laws.falls:
+        msg = (
+            f"cannot view this {name} yet: the page replays free flight between events, and this run is under "
+            f"gravity {laws.gravity} (plot its exact states with sim.trajectory(times) and discsim.plot instead)"
+        )
+        raise InvalidArgumentError(msg)
     context = getattr(sim, "run_context", None)
     stream = None if context is None else context.stream
     if stream is not None:  # the run streamed its log to disk: replay the file, with the engine's scene

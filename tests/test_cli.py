@@ -47,6 +47,20 @@ def test_demo_without_gif_and_with_another_policy(tmp_path, capsys):
     assert len(list(tmp_path.glob("*.png"))) == 5 and not list(tmp_path.glob("*.gif"))
 
 
+@pytest.mark.parametrize("policy", ["separate", "bisect"])
+def test_demo_lists_the_cases_under_the_laws_after_the_four(tmp_path, capsys, policy):
+    assert cli.main(["demo", "--out", str(tmp_path), "--no-gif", "--policy", policy]) == 0
+    text = capsys.readouterr().out
+    rows = [line.split() for line in text.splitlines() if line.startswith("bouncing_ball")]
+    if policy == "bisect":  # gravity needs a policy that answers at the frame
+        assert not rows and "cases under gravity need a policy that answers at the frame" in text
+        return
+    assert len(rows) == 1 and rows[0][1] == "30"
+    pic_hits, pit_hits, matched = (int(v) for v in rows[0][2:5])
+    assert pic_hits > 10 and 0 < matched <= min(pic_hits, pit_hits)
+    assert len(list(tmp_path.glob("*.png"))) == 5  # no figure of its own
+
+
 def test_usage_errors(capsys, tmp_path):
     assert cli.main([]) == 2  # no command: help, exit code 2
     assert "demo" in capsys.readouterr().err

@@ -4,9 +4,11 @@
 engine) and a run to judge (normally the fixed-step engine) from the same
 start, and reports what the second got wrong. It reads only the engine
 protocol (``discs``, ``box``, ``start_time``, ``time``, ``events``,
-``trajectory``, ``velocities``), plus two optional attributes when an engine
+``trajectory``, ``velocities``), plus optional attributes when an engine
 has them: ``dt`` (frame interval, for the frame times and the matching
-window) and ``max_overlap`` (deepest overlap it saw).
+window), ``max_overlap`` (deepest overlap it saw), and the laws of motion
+(``laws.gravity``, ``energy()``, ``dissipated``: the rebound heights and the
+energy error).
 """
 
 from __future__ import annotations
@@ -60,6 +62,21 @@ class Comparison:
             the truth (0 for an exact engine).
         truth_energy_change, approx_energy_change: relative change of the
             kinetic energy from the start to the end of each run.
+        wall_matches: ``(i, t_truth, t_approx)`` per wall or segment hit of disc
+            ``i`` found in both runs (matched per disc, nearest times first,
+            within ``window``, as collisions are); missed_wall_hits,
+            spurious_wall_hits: ``(i, -1, t)`` each.
+        wall_delays: ``(W,)`` ``t_approx - t_truth`` of the matched wall hits.
+        rebound_errors: ``(W,)`` under gravity, how much higher (length) the
+            disc rises after the matched hit in the approximation than in the
+            truth: each run's height at the hit plus ``v_up^2 / (2 g)`` from the
+            velocity it logged there (a bouncing ball's next apex); NaN without
+            gravity.
+        truth_energy_error, approx_energy_error: relative change from the start
+            to the end of each run of its energy (kinetic plus potential, for an
+            engine with ``energy()``) plus what its collision law dissipated
+            (``dissipated``): what the run lost or gained beyond its laws (0 for an
+            exact run; for elastic discs without gravity, the kinetic energy change).
     """
 
     truth_name: str
@@ -84,6 +101,13 @@ class Comparison:
     truth_max_overlap: float = 0.0
     truth_energy_change: float = 0.0
     approx_energy_change: float = 0.0
+    wall_matches: list = field(default_factory=list)
+    missed_wall_hits: list = field(default_factory=list)
+    spurious_wall_hits: list = field(default_factory=list)
+    wall_delays: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    rebound_errors: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    truth_energy_error: float = 0.0
+    approx_energy_error: float = 0.0
 
     @property
     def matched(self) -> int:
@@ -130,6 +154,22 @@ class Comparison:
         return float(finite.mean()) if finite.size else 0.0
 
     @property
+    def max_wall_delay(self) -> float:
+        """Largest ``|t_approx - t_truth|`` of a matched wall hit, signed (0 if none)."""
+        if not len(self.wall_delays):
+            return 0.0
+        return float(self.wall_delays[np.argmax(np.abs(self.wall_delays))])
+
+    @property
+    def max_rebound_error(self) -> float:
+        """Largest ``|rebound_errors|`` (length), signed; NaN without gravity, 0 without matched wall hits."""
+        if not len(self.rebound_errors):
+            return 0.0
+        if np.isnan(self.rebound_errors).all():
+            return math.nan
+        return float(self.rebound_errors[np.nanargmax(np.abs(self.rebound_errors))])
+
+    @property
     def position_error_final(self) -> float:
         """Largest position error at the last sample time (the horizon)."""
         return float(self.position_errors[-1]) if len(self.position_errors) else 0.0
@@ -161,6 +201,13 @@ class Comparison:
             "truth_max_overlap": self.truth_max_overlap,
             "truth_energy_change": self.truth_energy_change,
             "approx_energy_change": self.approx_energy_change,
+            "wall_matched": len(self.wall_matches),
+            "wall_missed": len(self.missed_wall_hits),
+            "wall_spurious": len(self.spurious_wall_hits),
+            "max_wall_delay": self.max_wall_delay,
+            "max_rebound_error": self.max_rebound_error,
+            "truth_energy_error": self.truth_energy_error,
+            "approx_energy_error": self.approx_energy_error,
         }
 
     def to_dict(self) -> dict:
@@ -182,6 +229,11 @@ class Comparison:
         out["matches"] = [list(m) for m in self.matches]
         out["missed_collisions"] = [list(m) for m in self.missed_collisions]
         out["spurious_collisions"] = [list(m) for m in self.spurious_collisions]
+        out["wall_matches"] = [list(m) for m in self.wall_matches]
+        out["missed_wall_hits"] = [list(m) for m in self.missed_wall_hits]
+        out["spurious_wall_hits"] = [list(m) for m in self.spurious_wall_hits]
+        out["wall_delays"] = self.wall_delays.tolist()
+        out["rebound_errors"] = clean(self.rebound_errors.tolist())
         out["delays"] = self.delays.tolist()
         out["direction_errors"] = clean(self.direction_errors.tolist())
         out["times"] = self.times.tolist()
@@ -218,6 +270,19 @@ class Comparison:
             f"  kinetic energy   relative change: truth {self.truth_energy_change:+.2e},"
             f" approx {self.approx_energy_change:+.2e}"
         )
+        if self.wall_matches or self.missed_wall_hits or self.spurious_wall_hits:
+            line = (
+                f"  wall hits        matched {len(self.wall_matches)}, missed {len(self.missed_wall_hits)},"
+                f" spurious {len(self.spurious_wall_hits)}; delay max {self.max_wall_delay:.4g}"
+            )
+            if not math.isnan(self.max_rebound_error):
+                line += f"; rebound height error max {self.max_rebound_error:.4g}"
+            lines.append(line)
+        if self.truth_energy_error != self.truth_energy_change or self.approx_energy_error != self.approx_energy_change:
+            lines.append(
+                f"  energy error     (kinetic + potential + dissipated) relative change: truth"
+                f" {self.truth_energy_error:+.2e}, approx {self.approx_energy_error:+.2e}"
+            )
         return "\n".join(lines)
 
 
@@ -302,6 +367,40 @@ def _deepest_overlap(engine, positions: np.ndarray, radii: np.ndarray) -> float:
     if tracked is not None:
         return max(float(tracked), 0.0)
     return _max_overlap(positions, radii, engine.box)
+
+
+def _gravity(engine) -> tuple[float, float]:
+    laws = getattr(engine, "laws", None)
+    return tuple(laws.gravity) if laws is not None else (0.0, 0.0)
+
+
+def _energy_error(engine) -> float:
+    """Relative change of ``energy() + dissipated`` from the start (kinetic plus potential there)."""
+    discs = engine.discs
+    gx, gy = _gravity(engine)
+    finite = np.isfinite(discs.masses)
+    e0 = kinetic_energy(discs.velocities, discs.masses)
+    e0 -= float(np.sum(discs.masses[finite] * (discs.positions[finite] @ np.array([gx, gy]))))
+    energy = getattr(engine, "energy", engine.kinetic_energy)
+    e1 = float(energy()) + float(getattr(engine, "dissipated", 0.0))
+    return (e1 - e0) / abs(e0) if e0 != 0 else 0.0
+
+
+def _wall_hits(events: np.ndarray):
+    """Wall and segment records as ``((disc, -1) -> [(time, row)])``."""
+    by_disc = defaultdict(list)
+    rows = np.flatnonzero(events["kind"] == WALL)
+    for r, t, i in zip(rows.tolist(), events["time"][rows].tolist(), events["i"][rows].tolist(), strict=True):
+        by_disc[(i, -1)].append((t, r))
+    return by_disc
+
+
+def _rebound(record, gravity: tuple[float, float]) -> float:
+    """How high (along ``-g``) a disc rises after a logged wall hit: its height there plus ``v_up^2 / (2 g)``."""
+    g = math.hypot(*gravity)
+    ux, uy = -gravity[0] / g, -gravity[1] / g
+    up = float(record["vxi"]) * ux + float(record["vyi"]) * uy
+    return float(record["xi"]) * ux + float(record["yi"]) * uy + max(up, 0.0) ** 2 / (2.0 * g)
 
 
 def _energy_change(engine) -> float:
@@ -431,6 +530,13 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     ev_a = ev_a[(ev_a["time"] >= start) & (ev_a["time"] <= reach)]
     matched, missed, spurious = _match(_collisions(ev_t), _collisions(ev_a), window)
     spurious = [(i, j, t) for i, j, t in spurious if t <= horizon]
+    wall_matched, wall_missed, wall_spurious = _match(_wall_hits(ev_t), _wall_hits(ev_a), window)
+    wall_spurious = [(i, j, t) for i, j, t in wall_spurious if t <= horizon]
+    gravity = _gravity(truth)
+    rebounds = np.full(len(wall_matched), np.nan)
+    if gravity != (0.0, 0.0):
+        for k, (_, (_, rt), (_, ra)) in enumerate(wall_matched):
+            rebounds[k] = _rebound(ev_a[ra], gravity) - _rebound(ev_t[rt], gravity)
     delays = np.array([ta - tt for _, (tt, _), (ta, _) in matched])
     directions = np.full((len(matched), 2), np.nan)
     for k, ((i, j), (_, rt), (_, ra)) in enumerate(matched):
@@ -484,4 +590,11 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
         truth_max_overlap=overlap_t,
         truth_energy_change=_energy_change(truth),
         approx_energy_change=_energy_change(approx),
+        wall_matches=[(i, tt, ta) for (i, _), (tt, _), (ta, _) in wall_matched],
+        missed_wall_hits=wall_missed,
+        spurious_wall_hits=wall_spurious,
+        wall_delays=np.array([ta - tt for _, (tt, _), (ta, _) in wall_matched]),
+        rebound_errors=rebounds,
+        truth_energy_error=_energy_error(truth),
+        approx_energy_error=_energy_error(approx),
     )

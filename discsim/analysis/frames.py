@@ -211,6 +211,17 @@ def _log_source(source, what: str):
     return (lambda: iter([sim.run_context.log.to_array()])), sim.discs, sim.box, sim.start_time, sim.time, sim
 
 
+def _refuse_gravity(engine, what: str) -> None:
+    """Refuse a run under gravity: the log's replay (:func:`discsim.trajectory.replay`) is free flight's."""
+    laws = getattr(engine, "laws", None)
+    if laws is not None and laws.falls:
+        msg = (
+            f"{what} replays free flight between events, and this run is under gravity {laws.gravity}: use "
+            "sim.trajectory(times) for exact positions, or sample the run with ds.Sampler(dt) while it runs"
+        )
+        raise InvalidArgumentError(msg)
+
+
 def frames(source, times) -> Frames:
     """The exact state of every disc at ``times``, rebuilt from a finished run's event log.
 
@@ -235,7 +246,8 @@ def frames(source, times) -> Frames:
         >>> f.positions.shape, bool(np.allclose(f.velocities[-1], sim.velocities))
         ((3, 50, 2), True)
     """
-    chunks, discs, box, start, end, _ = log_source(source, "frames()")
+    chunks, discs, box, start, end, engine = log_source(source, "frames()")
+    _refuse_gravity(engine, "frames()")
     times = check_times(times, start, end, "simulated span")
     # A streamed log is read one chunk at a time, up to the last time asked: memory flat in its length.
     origin = LastRecords.at_start(discs, start)

@@ -7,13 +7,12 @@ the quartic ``f(t) = |p(t)|^2 - sigma^2`` has a root. A coordinate under a unifo
 (a wall, a cell edge) where a quadratic has one.
 
 - :func:`accelerated_time_of_impact`: the first contact of the quartic, never missed: the roots of ``f''`` (a
-  quadratic) cut time into spans where ``f'`` is monotone, bisection finds the turning points of ``f`` in them
-  (:func:`turning_time`), and ``f`` is monotone between two turning points, where bisection finds its first
-  downward crossing (:func:`contact_on_span`).
+  quadratic) cut time into at most three pieces where ``f`` is convex or concave (:func:`convex_piece`,
+  :func:`concave_piece`), on which one crossing is bracketed and bisected (:func:`crossing_time`).
 - :func:`accelerated_exit`: the time a coordinate leaves a slab, by cancellation-free quadratic roots.
 
 With no acceleration each is free flight's (:func:`linear_contact`, :func:`linear_exit`, which live here too:
-this module is the floor of the law of motion, :mod:`discsim.physics.dynamics` calls it and it calls nothing of
+this module is the floor of the law of motion; :mod:`discsim.physics.dynamics` calls it, and it calls nothing of
 discsim). Every function uses only arithmetic, comparisons and :mod:`math`, so numba compiles it from this
 source: compile :data:`PARTS` in their order (callees first), e.g. ``compile_from_source(PARTS, jit)``.
 """
@@ -26,10 +25,11 @@ __all__ = [
     "PARTS",
     "accelerated_exit",
     "accelerated_time_of_impact",
-    "contact_on_span",
+    "concave_piece",
+    "convex_piece",
+    "crossing_time",
     "linear_contact",
     "linear_exit",
-    "turning_time",
 ]
 
 INF = math.inf
@@ -82,91 +82,145 @@ def linear_contact(dx: float, dy: float, dvx: float, dvy: float, sigma: float) -
 #: A contact is ruled out early only when the motion keeps farther than ``sigma`` from contact by this fraction
 #: of the problem's length scale: far beyond rounding, so the early outs never decide a close call.
 _MARGIN = 1e-9
+#: Likewise, a convex piece of ``f`` is found apart by its tangents only above this fraction of their roundoff.
+_TANGENT_MARGIN = 1e-12
 
 
-def turning_time(lo: float, hi: float, dx: float, dy: float, dvx: float, dvy: float, hx: float, hy: float) -> float:
-    """The turning point of ``f`` in ``(lo, hi]``, where ``f'`` is monotone (no root of ``f''`` inside).
-
-    ``f'(t) / 2 = p(t) . p'(t)`` with ``p(t) = d + w t + h t^2`` (``h`` is half the acceleration). Bisects
-    ``f'`` until the bracket is two adjacent floats and returns its upper end, where ``f'`` already has the sign
-    it has after the turning point (or is 0).
-
-    Args:
-        lo, hi: the span (time; ``0 <= lo <= hi``).
-        dx, dy, dvx, dvy: the relative position and velocity at time 0 (``d``, ``w``).
-        hx, hy: half the relative acceleration (length / time^2).
-
-    Returns:
-        The time in ``(lo, hi]`` at which ``f'`` changes sign, or -1.0 if it does not change sign there.
-
-    Example:
-        >>> turning_time(0.0, 4.0, 0.0, 5.0, 0.0, 2.0, 0.0, -0.5)  # thrown up at 2, falling at 1: the top at t = 2
-        2.0
-    """
-    ax, ay = hx + hx, hy + hy
-    px, py = dx + lo * (dvx + lo * hx), dy + lo * (dvy + lo * hy)
-    rate_lo = px * (dvx + lo * ax) + py * (dvy + lo * ay)
-    px, py = dx + hi * (dvx + hi * hx), dy + hi * (dvy + hi * hy)
-    rate_hi = px * (dvx + hi * ax) + py * (dvy + hi * ay)
-    if rate_hi == 0.0 and rate_lo != 0.0:
-        return hi
-    if not ((rate_lo < 0.0 < rate_hi) or (rate_lo > 0.0 > rate_hi)):
-        return -1.0
-    rising = rate_lo < 0.0  # f' goes from - to + (a minimum of f)
-    while True:
-        t = 0.5 * (lo + hi)
-        if not lo < t < hi:  # adjacent floats (or no number: never loop for ever)
-            return hi
-        px, py = dx + t * (dvx + t * hx), dy + t * (dvy + t * hy)
-        rate = px * (dvx + t * ax) + py * (dvy + t * ay)
-        if (rate < 0.0) if rising else (rate > 0.0):
-            lo = t
-        else:
-            hi = t
-
-
-def contact_on_span(
-    lo: float, hi: float, dx: float, dy: float, dvx: float, dvy: float, hx: float, hy: float, sigma: float
+def crossing_time(
+    lo: float, hi: float, dx: float, dy: float, dvx: float, dvy: float, hx: float, hy: float, s2: float
 ) -> float:
-    """The first contact while approaching in ``[lo, hi]``, a span between turning points (``f`` monotone).
+    """The downward crossing of ``f`` in ``(lo, hi]``, given ``f(lo) > 0 >= f(hi)``: bisection of ``f`` until the
+    bracket is two adjacent floats, and its upper end (``f`` is ``<= 0`` there and ``> 0`` at the float before).
 
-    ``lo`` itself if the pair touches or overlaps there and approaches (``f(lo) <= 0`` and ``f`` decreasing);
-    else, if ``f`` crosses zero downwards in the span, the time of the crossing: bisection of ``f`` until the
-    bracket is two adjacent floats, whose upper end is returned (the computed ``f`` is ``<= 0`` there and
-    ``> 0`` at the float before it).
+    ``f(t) = |p(t)|^2 - s2`` with ``p(t) = d + t (w + t h)``; the callers choose a bracket holding one crossing.
 
     Args:
-        lo, hi: the span (time; ``0 <= lo <= hi``).
+        lo, hi: the bracket (time; ``0 <= lo < hi``).
         dx, dy, dvx, dvy: the relative position and velocity at time 0 (``d``, ``w``).
-        hx, hy: half the relative acceleration (length / time^2).
-        sigma: the contact distance (length).
-
-    Returns:
-        The time of contact in ``[lo, hi]``, or ``math.inf`` if none.
+        hx, hy: half the relative acceleration (``h``, length / time^2).
+        s2: the contact distance squared (length^2).
 
     Example:
-        >>> contact_on_span(0.0, 2.5, 0.0, 3.0, 0.0, 0.0, 0.0, -0.5, 1.0)  # falls 2 from rest at 1: t = 2
+        >>> crossing_time(0.0, 2.5, 0.0, 3.0, 0.0, 0.0, 0.0, -0.5, 1.0)  # falls 2 from rest at 1: t = 2
         2.0
     """
-    s2 = sigma * sigma
-    px, py = dx + lo * (dvx + lo * hx), dy + lo * (dvy + lo * hy)
-    if px * px + py * py - s2 <= 0.0:  # touching or overlapping at lo: a contact if approaching
-        ax, ay = hx + hx, hy + hy
-        rate = px * (dvx + lo * ax) + py * (dvy + lo * ay)
-        if rate == 0.0:  # at a turning point: the span's middle says which way f goes
-            t = 0.5 * (lo + hi)
-            qx, qy = dx + t * (dvx + t * hx), dy + t * (dvy + t * hy)
-            rate = qx * (dvx + t * ax) + qy * (dvy + t * ay)
-        return lo if rate < 0.0 else INF
-    px, py = dx + hi * (dvx + hi * hx), dy + hi * (dvy + hi * hy)
-    if px * px + py * py - s2 > 0.0:
-        return INF
     while True:
         t = 0.5 * (lo + hi)
         if not lo < t < hi:  # adjacent floats (or no number: never loop for ever)
             return hi
         px, py = dx + t * (dvx + t * hx), dy + t * (dvy + t * hy)
         if px * px + py * py - s2 > 0.0:
+            lo = t
+        else:
+            hi = t
+
+
+def convex_piece(
+    lo: float, hi: float, dx: float, dy: float, dvx: float, dvy: float, hx: float, hy: float, s2: float
+) -> float:
+    """The first contact while approaching in ``[lo, hi]``, where ``f`` is convex (``f'' >= 0``: ``f'`` rises).
+
+    ``lo`` if the pair touches or overlaps there and approaches. Else a crossing needs ``f`` falling at ``lo``;
+    if ``f(hi) <= 0`` it is the one crossing of the span (:func:`crossing_time`); if ``f`` still falls at
+    ``hi``, there is none; otherwise ``f`` has its minimum inside, which bisection of ``f'`` closes in on until
+    a time with ``f <= 0`` brackets the crossing (before the minimum), or the tangents at the bracket's ends,
+    below a convex ``f``, keep it above 0 (no contact, told with a margin far beyond roundoff), or the bracket
+    is two adjacent floats, both apart (no contact).
+
+    Args:
+        lo, hi: the span (time; ``0 <= lo < hi``).
+        dx, dy, dvx, dvy, hx, hy, s2: as for :func:`crossing_time`.
+
+    Returns:
+        The time of contact in ``[lo, hi]``, or ``math.inf`` if none.
+
+    Example:
+        >>> convex_piece(1.5, 10.0, 0.0, 3.0, 0.0, 0.0, 0.0, -0.5, 1.0)  # falling through the disc: lands at 2
+        2.0
+    """
+    ax, ay = hx + hx, hy + hy
+    px, py = dx + lo * (dvx + lo * hx), dy + lo * (dvy + lo * hy)
+    f_lo = px * px + py * py - s2
+    g_lo = px * (dvx + lo * ax) + py * (dvy + lo * ay)  # f' / 2
+    if g_lo >= 0.0:  # f' rises from >= 0: f rises all along, never approaching
+        return INF
+    if f_lo <= 0.0:
+        return lo
+    px, py = dx + hi * (dvx + hi * hx), dy + hi * (dvy + hi * hy)
+    f_hi = px * px + py * py - s2
+    if f_hi <= 0.0:
+        return crossing_time(lo, hi, dx, dy, dvx, dvy, hx, hy, s2)
+    g_hi = px * (dvx + hi * ax) + py * (dvy + hi * ay)
+    if g_hi <= 0.0:  # falling all along, and still apart at hi
+        return INF
+    while True:
+        # The tangents at lo and hi meet at the lowest point of their maximum, below f: if that is above 0,
+        # no contact. Times (g_hi - g_lo) > 0; every term of the margin is >= 0.
+        width = hi - lo
+        lowest = f_lo * g_hi - g_lo * f_hi + 2.0 * g_lo * g_hi * width
+        margin = (f_lo + f_hi + 2.0 * s2) * (g_hi - g_lo) + f_lo * g_hi - g_lo * f_hi - 2.0 * g_lo * g_hi * width
+        if lowest > _TANGENT_MARGIN * margin:
+            return INF
+        t = 0.5 * (lo + hi)
+        if not lo < t < hi:  # at the minimum, apart on both sides
+            return INF
+        px, py = dx + t * (dvx + t * hx), dy + t * (dvy + t * hy)
+        f_t = px * px + py * py - s2
+        if f_t <= 0.0:  # apart at lo, in contact at t: the crossing lies between
+            return crossing_time(lo, t, dx, dy, dvx, dvy, hx, hy, s2)
+        g_t = px * (dvx + t * ax) + py * (dvy + t * ay)
+        if g_t < 0.0:
+            lo, f_lo, g_lo = t, f_t, g_t
+        else:
+            hi, f_hi, g_hi = t, f_t, g_t
+
+
+def concave_piece(
+    lo: float, hi: float, dx: float, dy: float, dvx: float, dvy: float, hx: float, hy: float, s2: float
+) -> float:
+    """The first contact while approaching in ``[lo, hi]``, where ``f`` is concave (``f'' <= 0``: ``f'`` falls).
+
+    Apart at ``lo``: the one crossing of the span if ``f(hi) <= 0`` (a concave ``f`` is above its chord), else
+    none. Touching or overlapping at ``lo`` and approaching (or at rest, ``f'`` then falling below 0): ``lo``.
+    Overlapping and separating (just after a bounce): ``f`` rises to a maximum and falls; bisection of ``f'``
+    closes in on the maximum until a time with ``f > 0`` shows the pair came apart (the contact is then the
+    crossing after it), or the bracket is two adjacent floats with ``f <= 0``: a bounce too weak to part the
+    pair by more than roundoff turns back in contact, and that time is the contact.
+
+    Args:
+        lo, hi: the span (time; ``0 <= lo < hi``).
+        dx, dy, dvx, dvy, hx, hy, s2: as for :func:`crossing_time`.
+
+    Returns:
+        The time of contact in ``[lo, hi]``, or ``math.inf`` if none.
+
+    Example:
+        >>> concave_piece(0.0, 1.0, 0.0, 1.0, 0.0, 3.0, 0.0, -0.5, 1.0)  # bounced up at 3: apart until t = 6
+        inf
+    """
+    px, py = dx + lo * (dvx + lo * hx), dy + lo * (dvy + lo * hy)
+    f_lo = px * px + py * py - s2
+    if f_lo > 0.0:
+        px, py = dx + hi * (dvx + hi * hx), dy + hi * (dvy + hi * hy)
+        if px * px + py * py - s2 > 0.0:
+            return INF
+        return crossing_time(lo, hi, dx, dy, dvx, dvy, hx, hy, s2)
+    ax, ay = hx + hx, hy + hy
+    if px * (dvx + lo * ax) + py * (dvy + lo * ay) <= 0.0:
+        return lo
+    px, py = dx + hi * (dvx + hi * hx), dy + hi * (dvy + hi * hy)
+    if px * px + py * py - s2 > 0.0:  # apart at hi: no crossing back before it
+        return INF
+    if px * (dvx + hi * ax) + py * (dvy + hi * ay) >= 0.0:  # still separating at hi, in contact all along
+        return INF
+    while True:
+        t = 0.5 * (lo + hi)
+        if not lo < t < hi:  # the turn, still in contact
+            return hi
+        px, py = dx + t * (dvx + t * hx), dy + t * (dvy + t * hy)
+        if px * px + py * py - s2 > 0.0:  # apart at t: the crossing back lies after it
+            return crossing_time(t, hi, dx, dy, dvx, dvy, hx, hy, s2)
+        if px * (dvx + t * ax) + py * (dvy + t * ay) > 0.0:
             lo = t
         else:
             hi = t
@@ -189,13 +243,22 @@ def accelerated_time_of_impact(
       computed (a bounce too weak to lift off by more than roundoff), the time it turns.
     - otherwise the first downward crossing of zero, or ``math.inf`` if there is none.
 
-    A crossing is found by bisection to the last bit: the returned ``t`` is the first float at which the
-    computed ``f`` is ``<= 0`` (the discs at contact or inside it by roundoff), the float before it being
-    outside. No contact is missed: ``f'`` is monotone between the roots of ``f''`` (a quadratic), which gives
-    every turning point of ``f`` (:func:`turning_time`), and ``f`` is monotone between those
-    (:func:`contact_on_span`); no contact lies after ``T = 2 (|w| + sqrt(|w|^2 + 2 |a| (|d| + sigma))) / |a|``,
+    A crossing is found by bisection to the last bit (:func:`crossing_time`). What the returned ``t`` means:
+    ``f`` computed as ``|d + t (w + t a / 2)|^2 - sigma^2`` is ``<= 0`` at ``t`` and ``> 0`` at the float just
+    before it, so the discs are at contact or inside it by roundoff, never before it; the loops resolve the
+    collision at ``t`` (for an acceleration taken in another time unit, see below, the same in that unit).
+    Bisection, not a faster false position: the computed ``f`` of a pair just parted by a bounce is 0 within
+    roundoff for a while, and false position, drawn to the end where ``|f|`` is smallest, stops there on a
+    crossing of roundoff (a 1e-15 instead of the come-back: tests/physics/test_roots.py keeps such a case).
+
+    No contact is missed: between the roots of ``f''`` (a quadratic, cancellation-free) ``f`` is convex or
+    concave, so that on each piece its values and slopes at the ends, and at most one bisection of ``f'``
+    towards its minimum or maximum, say whether and where it crosses zero (:func:`convex_piece`,
+    :func:`concave_piece`); no contact lies after ``T = 2 (|w| + sqrt(|w|^2 + 2 |a| (|d| + sigma))) / |a|``,
     where ``|p| >= |a| t^2 / 2 - |w| t - |d| > sigma``. Two cheap tests answer ``inf`` first when the motion
     across ``a`` (a line) or along ``a`` (a parabola) keeps the pair farther apart than ``sigma`` until ``T``.
+    An acceleration outside ``1e-100 < max(|ax|, |ay|) < 1e100`` is taken in a time unit of a power of two
+    in which it is about 1 (exact scaling), so that ``|a|^2`` neither underflows nor overflows.
 
     With ``ax == ay == 0`` it is :func:`~discsim.physics.dynamics.pair_time_of_impact`, bit for bit.
 
@@ -246,11 +309,12 @@ def accelerated_time_of_impact(
     along0 = (dx * ax + dy * ay) / a_norm
     along_rate = (dvx * ax + dvy * ay) / a_norm
     along1 = along0 + horizon * (along_rate + horizon * 0.5 * a_norm)
-    t = min(max(-along_rate / a_norm, 0.0), horizon)
-    if along0 + t * (along_rate + t * 0.5 * a_norm) > reach or max(along0, along1) < -reach:
+    t = -along_rate / a_norm  # the lowest point, kept within [0, horizon]
+    t = 0.0 if t <= 0.0 else (horizon if t >= horizon else t)
+    if along0 + t * (along_rate + t * 0.5 * a_norm) > reach or (along0 < -reach and along1 < -reach):
         return INF
-    # f''(t) / 2 = A t^2 + 2 B t + C: its roots (cancellation-free) cut [0, horizon] into spans where f' is
-    # monotone.
+    # f''(t) / 2 = A t^2 + 2 B t + C: its roots (cancellation-free) cut [0, horizon] into pieces where f is
+    # convex (before the first, after the second) or concave (between them).
     qa = 1.5 * a2
     qb = 1.5 * (dvx * ax + dvy * ay)
     qc = w2 + dx * ax + dy * ay
@@ -259,28 +323,20 @@ def accelerated_time_of_impact(
     if disc > 0.0:
         q = -(qb + math.copysign(math.sqrt(disc), qb))
         r1, r2 = q / qa, qc / q
-        first = min(max(min(r1, r2), 0.0), horizon)
-        second = min(max(max(r1, r2), 0.0), horizon)
-    start = 0.0
-    turn = turning_time(0.0, first, dx, dy, dvx, dvy, hx, hy)
-    if turn >= 0.0:
-        t = contact_on_span(start, turn, dx, dy, dvx, dvy, hx, hy, sigma)
-        if t < INF:
-            return t * unit
-        start = turn
-    turn = turning_time(first, second, dx, dy, dvx, dvy, hx, hy)
-    if turn >= 0.0:
-        t = contact_on_span(start, turn, dx, dy, dvx, dvy, hx, hy, sigma)
-        if t < INF:
-            return t * unit
-        start = turn
-    turn = turning_time(second, horizon, dx, dy, dvx, dvy, hx, hy)
-    if turn >= 0.0:
-        t = contact_on_span(start, turn, dx, dy, dvx, dvy, hx, hy, sigma)
-        if t < INF:
-            return t * unit
-        start = turn
-    return contact_on_span(start, horizon, dx, dy, dvx, dvy, hx, hy, sigma) * unit
+        if r1 > r2:
+            r1, r2 = r2, r1
+        # Within [0, horizon], written out (not min and max: no -0.0 where one root is -0.0)
+        first = 0.0 if r1 <= 0.0 else (horizon if r1 >= horizon else r1)
+        second = 0.0 if r2 <= 0.0 else (horizon if r2 >= horizon else r2)
+    s2 = sigma * sigma
+    t = INF
+    if first > 0.0:
+        t = convex_piece(0.0, first, dx, dy, dvx, dvy, hx, hy, s2)
+    if t == INF and second > first:
+        t = concave_piece(first, second, dx, dy, dvx, dvy, hx, hy, s2)
+    if t == INF and horizon > second:
+        t = convex_piece(second, horizon, dx, dy, dvx, dvy, hx, hy, s2)
+    return t * unit
 
 
 def accelerated_exit(x: float, v: float, a: float, lo: float, hi: float) -> tuple[float, int]:
@@ -345,4 +401,12 @@ def accelerated_exit(x: float, v: float, a: float, lo: float, hi: float) -> tupl
 
 
 #: The functions to compile, callees first.
-PARTS = (linear_exit, linear_contact, turning_time, contact_on_span, accelerated_time_of_impact, accelerated_exit)
+PARTS = (
+    linear_exit,
+    linear_contact,
+    crossing_time,
+    convex_piece,
+    concave_piece,
+    accelerated_time_of_impact,
+    accelerated_exit,
+)

@@ -230,3 +230,23 @@ def test_until_lets_a_detection_just_past_the_horizon_match():
     assert ds.compare(pic_short, pit_short, window=0.1).missed == 1
     with pytest.raises(ValueError, match="until=5.0 must lie within"):
         ds.compare(pic, pit, until=5.0)
+
+
+def test_wall_hits_are_matched_per_disc_with_their_delays():
+    discs = ds.Discs([[5.0, 5.0]], [[3.0, 0.0]], radii=1.0)
+    pic = ds.EventDriven(discs, ds.Box(10.0, 10.0)).run(until=3.5)
+    pit = ds.FixedStep(discs, ds.Box(10.0, 10.0), frame_rate=10.0).run(until=3.5)
+    report = ds.compare(pic, pit)
+    # The right wall at t = 4/3 (x + r = 9 + 1); PIT sees the disc past it at the next frame, t = 1.4.
+    assert len(report.wall_matches) == 1 and not report.missed_wall_hits and not report.spurious_wall_hits
+    i, t_truth, t_approx = report.wall_matches[0]
+    assert i == 0 and t_truth == pytest.approx(4.0 / 3.0) and t_approx == pytest.approx(1.4)
+    assert report.max_wall_delay == pytest.approx(1.4 - 4.0 / 3.0)
+    assert math.isnan(report.max_rebound_error) and math.isnan(report.rebound_errors[0])  # no gravity
+    assert report.truth_energy_error == report.truth_energy_change == 0.0
+    summary = report.summary()
+    assert summary["wall_matched"] == 1 and summary["max_wall_delay"] == pytest.approx(0.0667, abs=1e-4)
+    assert json.loads(json.dumps(report.to_dict()))["rebound_errors"] == [None]
+    text = str(report)
+    assert "wall hits        matched 1, missed 0, spurious 0; delay max 0.06667" in text
+    assert "rebound" not in text and "energy error" not in text

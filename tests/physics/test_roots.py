@@ -3,14 +3,16 @@
 ``accelerated_time_of_impact`` is held to closed forms (a fall from rest, a projectile, the come-back after a
 bounce, a miss, a graze), to a brute force (numpy's roots of the quartic, polished, and a dense sampling that
 would see any contact the function missed; exact rational arithmetic for the sign of ``f`` at the answer), to
-``pair_time_of_impact`` bit for bit without acceleration, and its compiled form to its Python form bit for bit.
-``accelerated_exit`` likewise against the quadratic's roots and ``exit_x``.
+``pair_time_of_impact`` bit for bit without acceleration, and its compiled form to its Python form bit for bit;
+a ball bouncing on a fixed disc until it rolls off keeps its energy. ``accelerated_exit`` likewise against the
+quadratic's roots (and 50-digit roots close to a line), ``exit_x``, and a coordinate bouncing on a floor.
 """
 
 from __future__ import annotations
 
 import math
 import struct
+from decimal import Decimal, localcontext
 from fractions import Fraction
 
 import numpy as np
@@ -126,6 +128,12 @@ def _exact_f(t, d, w, a, sigma):
     return px * px + py * py - Fraction(sigma) ** 2
 
 
+def _computed_f(t, d, w, a, sigma):
+    """f as the contract of accelerated_time_of_impact computes it: |d + t (w + t a / 2)|^2 - sigma^2."""
+    px, py = d[0] + t * (w[0] + t * (0.5 * a[0])), d[1] + t * (w[1] + t * (0.5 * a[1]))
+    return px * px + py * py - sigma * sigma
+
+
 def _toi(d, w, a, sigma):
     return accelerated_time_of_impact(d[0], d[1], w[0], w[1], a[0], a[1], sigma)
 
@@ -150,6 +158,8 @@ def _same(x, y) -> bool:
 def test_a_point_falling_from_rest_onto_a_fixed_disc_lands_at_sqrt_2h_over_g(h, g, sigma):
     t = accelerated_time_of_impact(0.0, sigma + h, 0.0, 0.0, 0.0, -g, sigma)
     assert t == pytest.approx(math.sqrt(2.0 * h / g), rel=1e-12, abs=0.0)
+    d, w, a = (0.0, sigma + h), (0.0, 0.0), (0.0, -g)
+    assert _computed_f(t, d, w, a, sigma) <= 0.0 < _computed_f(math.nextafter(t, 0.0), d, w, a, sigma)
     # Sideways gravity: the same fall rotated by 90 degrees.
     assert accelerated_time_of_impact(-(sigma + h), 0.0, 0.0, 0.0, g, 0.0, sigma) == t
 
@@ -181,7 +191,7 @@ def test_a_vertical_bounce_on_top_of_a_fixed_disc_comes_back_at_2v_over_g(v, g, 
     for y in (sigma, sigma * (1.0 - 2.0**-52), math.nextafter(sigma, 0.0), math.nextafter(sigma, 9.0)):
         t = accelerated_time_of_impact(0.0, y, 0.0, v, 0.0, -g, sigma)
         assert t == pytest.approx(expected, rel=1e-9)
-    # Before the fix that never was: touching and approaching collides at once.
+    # Touching or overlapping, and approaching: at once.
     assert accelerated_time_of_impact(0.0, sigma, 0.0, -v, 0.0, -g, sigma) == 0.0
     assert accelerated_time_of_impact(0.0, 0.9 * sigma, 0.0, -v, 0.0, -g, sigma) == 0.0
 
@@ -192,6 +202,17 @@ def test_an_oblique_bounce_straight_up_comes_back_to_the_same_point_at_2v_over_g
     sigma, v, g = 1.0, 1.5, 1.0
     d = (sigma * math.cos(math.pi / 3), sigma * math.sin(math.pi / 3))
     assert _toi(d, (0.0, v), (0.0, -g), sigma) == pytest.approx(2.0 * v / g, rel=1e-12)
+
+
+def test_a_bounce_whose_gap_stays_within_roundoff_for_a_while_comes_back_all_the_same():
+    # Leaving the circle slowly and obliquely: the computed f is one float above 0 at t = 0 and 0 again at
+    # about 1e-15, before the pair parts for good; the contact is the come-back at 0.1367, not that float.
+    # (Found by hypothesis against a false-position search, which stopped at 1.05e-15.)
+    angle, speed_out, turn, sigma = 0.08984375, 0.125, -1.0, 1.254490713488739
+    d = (sigma * math.cos(angle), sigma * math.sin(angle))
+    w = (speed_out * math.cos(angle + turn), speed_out * math.sin(angle + turn))
+    assert _computed_f(1.0545436435450911e-15, d, w, (-1.0, 0.0), sigma) <= 0.0  # the crossing of roundoff
+    assert _toi(d, w, (-1.0, 0.0), sigma) == pytest.approx(0.136696015387724, rel=1e-12)
 
 
 def test_no_contact_when_the_pull_points_away_or_the_path_passes_by():
@@ -234,6 +255,45 @@ def test_a_bounce_too_weak_to_lift_off_by_more_than_roundoff_comes_back_at_its_t
     assert 0.0 < t < 1e-15
 
 
+def test_a_ball_bouncing_on_a_fixed_disc_keeps_its_energy_and_never_sinks_in():
+    # A point released slightly off the top of a fixed disc (radius 1, g = 1) bounces elastically (the normal
+    # velocity reversed) until it rolls off: every contact at the disc's surface within roundoff, none at once
+    # after the last, the energy |v|^2 / 2 + g y unchanged, and in the end a free fall past the disc.
+    sigma, g = 1.0, 1.0
+    x, y, vx, vy = 1e-6, 1.5, 0.0, 0.0
+    energy = 0.5 * (vx * vx + vy * vy) + g * y
+    bounces = 0
+    while True:
+        t = accelerated_time_of_impact(x, y, vx, vy, 0.0, -g, sigma)
+        if t == math.inf:
+            break
+        assert t > 1e-6  # never the bounce just resolved again
+        x, y, vx, vy = x + t * vx, y + t * (vy - 0.5 * g * t), vx, vy - g * t
+        assert abs(math.hypot(x, y) - sigma) < 1e-12
+        nx, ny = x / sigma, y / sigma
+        vn = vx * nx + vy * ny
+        assert vn < 0.0
+        vx, vy = vx - 2.0 * vn * nx, vy - 2.0 * vn * ny
+        assert 0.5 * (vx * vx + vy * vy) + g * y == pytest.approx(energy, rel=1e-12)
+        bounces += 1
+        assert bounces < 1000
+    assert bounces == 8 and y < sigma  # bounced 8 times (the offset grows), then rolled off the side
+
+
+def test_a_coordinate_bouncing_on_a_floor_keeps_its_period():
+    # x'' = -g over a floor at 0.3, reflected at every exit through it: the period stays 2 v / g and the
+    # coordinate at each bounce is the floor within roundoff, whichever side of it roundoff leaves it.
+    g, floor, v = 9.81, 0.3, 1.7
+    x, below = floor, 0
+    for _ in range(2000):
+        t, side = accelerated_exit(x, v, -g, floor, 100.0)
+        assert side == -1 and t == pytest.approx(2.0 * 1.7 / g, rel=1e-12)
+        x, v = x + v * t - 0.5 * g * t * t, g * t - v
+        below += x < floor
+        assert abs(x - floor) < 1e-12
+    assert below > 1000  # roundoff left it below the floor, and it came back all the same
+
+
 # --- brute force ---------------------------------------------------------------------------------------------
 
 
@@ -255,6 +315,8 @@ def _check_against_brute_force(d, w, a, sigma):
         scale = (math.hypot(*d) + math.hypot(*w) * t + math.hypot(*a) * t * t + sigma) ** 2
         assert _exact_f(t, d, w, a, sigma) <= 8 * 2.0**-52 * scale
         assert _exact_f(math.nextafter(t, 0.0), d, w, a, sigma) >= -8 * 2.0**-52 * scale
+        # The contract to the last bit: computed f <= 0 at the answer, > 0 at the float before it.
+        assert _computed_f(t, d, w, a, sigma) <= 0.0 < _computed_f(math.nextafter(t, 0.0), d, w, a, sigma)
     return t
 
 
@@ -269,6 +331,7 @@ def test_the_contact_time_agrees_with_a_brute_force(dx, dy, dvx, dvy, ax, ay, si
 
 @settings(max_examples=200, deadline=None)
 @given(st.floats(0.0, 2.0 * math.pi), st.floats(0.05, 3.0), st.floats(-1.4, 1.4), pull, pull, sigma_)
+@example(0.08984375, 0.125, -1.0, -1.0, 0.0, 1.254490713488739)  # f(0) one float above 0, then 0 for a while
 def test_the_come_back_after_a_bounce_is_found_and_never_zero(angle, speed_out, turn, ax, ay, sigma):
     # A point on the circle (|d| = sigma up to roundoff, either side) leaving it: normal speed > 0.
     d = (sigma * math.cos(angle), sigma * math.sin(angle))
@@ -299,8 +362,10 @@ def test_the_come_back_after_a_bounce_is_found_and_never_zero(angle, speed_out, 
 @settings(max_examples=200, deadline=None)
 @given(position, position, speed, speed, pull, pull, sigma_, st.integers(-40, 40))
 def test_a_time_unit_of_a_power_of_two_changes_nothing_but_the_unit(dx, dy, dvx, dvy, ax, ay, sigma, k):
-    # Time in units of 2^k: velocities times 2^k, accelerations times 4^k, the contact time over 2^k, exactly.
+    # Time in units of 2^k: velocities times 2^k, accelerations times 4^k, the contact time over 2^k, exactly
+    # (as long as nothing is so small that its products are subnormal and lose bits).
     assume(max(abs(ax), abs(ay)) > 1e-3)
+    assume(all(x == 0.0 or abs(x) > 1e-100 for x in (dx, dy, dvx, dvy, ax, ay)))
     t = accelerated_time_of_impact(dx, dy, dvx, dvy, ax, ay, sigma)
     scaled = accelerated_time_of_impact(
         dx, dy, math.ldexp(dvx, k), math.ldexp(dvy, k), math.ldexp(ax, 2 * k), math.ldexp(ay, 2 * k), sigma
@@ -386,6 +451,29 @@ def test_exit_of_a_coordinate_already_past_its_line():
     # Past it and moving away from it (a bounce that left it past the line): back to where it is.
     assert accelerated_exit(-1.0, 0.5, -2.0, 0.0, 10.0) == (0.5, -1)
     assert accelerated_exit(11.0, -0.5, 2.0, 0.0, 10.0) == (0.5, 1)
+
+
+@settings(max_examples=300)
+@given(st.floats(-1e3, 1e3), st.floats(0.01, 5.0), st.floats(0.01, 5.0), st.integers(1, 15), st.booleans())
+def test_an_exit_close_to_a_line_is_accurate_to_roundoff(x, speed_in, g, digits, upwards):
+    # 10^-digits from the line, moving towards it under a pull either way: the time to roundoff, against the
+    # root computed with 40 digits (the textbook formula loses them: (-v - s) / a with s close to -v).
+    gap = 10.0**-digits
+    line = x + gap if upwards else x - gap
+    assume(line != x)  # the gap not lost to x's roundoff (the exact root below takes the line as it is)
+    v = speed_in if upwards else -speed_in
+    for a in (g, -g):
+        if a * v < 0.0 and v * v <= 4.0 * g * gap:
+            continue  # pulled back before it gets there
+        lo, hi = (x - 1e4, line) if upwards else (line, x + 1e4)
+        t, side = accelerated_exit(x, v, a, lo, hi)
+        assert side == (1 if upwards else -1)
+        with localcontext() as context:
+            context.prec = 50
+            dv, da, dgap = Decimal(v), Decimal(a), Decimal(line) - Decimal(x)
+            s = (dv * dv + 2 * da * dgap).sqrt()
+            exact = (-dv + s) / da if upwards else (-dv - s) / da
+        assert t == pytest.approx(float(exact), rel=1e-13, abs=0.0)
 
 
 @settings(max_examples=300)

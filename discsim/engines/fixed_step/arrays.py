@@ -11,7 +11,9 @@ import numpy as np
 
 from discsim.engines.fixed_step.parts import impulse_virial, wrap
 from discsim.events import EventLog
+from discsim.laws import PER_GROUP, E, Laws
 from discsim.model import image_step, image_steps
+from discsim.physics.dynamics import advance
 from discsim.scene import Scene
 
 __all__ = ["Paths", "Shapes", "Tally", "impulse_virial"]
@@ -31,9 +33,14 @@ class Shapes:
             ``(x0, y0, x1, y1)``): the same as floats.
         group (list of N ints) and blocked (G lists of G bools): the collision filter
             (:meth:`~discsim.scene.Scene.passes`) as lists, or None when no groups pass through each other.
+        laws: the run's :class:`~discsim.laws.Laws`. gravity: ``(gx, gy)``. falls ``(N,)`` bool: the discs
+            gravity moves (finite mass; all False without gravity).
+        e (float), per_group (bool), e_table (G lists of G floats), e_group (list of N ints), tc (float): the
+            arguments of :func:`~discsim.engines.fixed_step.parts.restitution` (``e_group`` indexes
+            ``e_table`` by the rank of each disc's group label).
     """
 
-    def __init__(self, scene: Scene):
+    def __init__(self, scene: Scene, laws: Laws | None = None):
         discs, box = scene.discs, scene.box
         self.scene = scene
         self.box = box
@@ -49,14 +56,25 @@ class Shapes:
         self.seg_ends = [(*segment.p0.tolist(), *segment.p1.tolist()) for segment in scene.segments]
         self.group = scene.group.tolist() if scene.filtering else None
         self.blocked = scene.blocked.tolist() if scene.filtering else None
+        laws = Laws.build() if laws is None else laws
+        self.laws = laws
+        self.gravity = laws.gravity
+        self.falls = np.isfinite(discs.masses) & laws.falls
+        law = laws.array(discs.radii)
+        self.e, self.per_group, self.tc = float(law[E]), bool(law[PER_GROUP]), laws.tc
+        labels = np.unique(discs.groups)
+        self.e_table = laws.table(labels).tolist()
+        self.e_group = np.searchsorted(labels, discs.groups).tolist()
 
 
 class Paths:
-    """Each disc's straight path since it last changed course, and where the discs were at the last frame.
+    """Each disc's path since it last changed course, and where the discs were at the last frame.
 
     Disc ``i`` is at ``ref_positions[i] + velocities[i] * (t - ref_times[i])`` (lazy clocks, as in the
     event log, so frame positions and ``trajectory()`` agree to the last bit); that point is not wrapped,
-    and adding ``images[i] * box.size`` to it unwraps it.
+    and adding ``images[i] * box.size`` to it unwraps it. Under gravity a disc that falls follows the
+    parabola of :func:`~discsim.physics.dynamics.advance` from there instead, ``velocities[i]`` being its
+    velocity at ``ref_times[i]``; every frame starts its path afresh (:meth:`fall`).
 
     Attributes:
         box: the :class:`~discsim.model.Box`.
@@ -65,19 +83,51 @@ class Paths:
         velocities ``(N, 2)``: the velocities (length per time).
         images ``(N, 2)`` int64: box lengths to add to ``ref_positions`` to unwrap them.
         frame_positions ``(N, 2)``: the positions at the last frame, wrapped into a periodic box.
+        last_collision ``(N,)``: each disc's last response time (``-inf``: none; kept for the TC model only).
+        gravity: ``(gx, gy)``; falls ``(N,)`` bool: the discs it moves (None: no gravity).
     """
 
-    def __init__(self, box, ref_positions, ref_times, velocities, images, frame_positions):
+    def __init__(
+        self, box, ref_positions, ref_times, velocities, images, frame_positions, last_collision=None,
+        gravity=(0.0, 0.0), falls=None,
+    ):  # fmt: skip
         self.box = box
         self.ref_positions = ref_positions
         self.ref_times = ref_times
         self.velocities = velocities
         self.images = images
         self.frame_positions = frame_positions
+        self.last_collision = np.full(len(ref_times), -np.inf) if last_collision is None else last_collision
+        self.gravity = (float(gravity[0]), float(gravity[1]))
+        self.falls = falls if falls is not None and gravity != (0.0, 0.0) and falls.any() else None
 
     def flown(self, t: float) -> np.ndarray:
         """``(N, 2)`` positions at time ``t`` on the current paths, not wrapped."""
-        return self.ref_positions + self.velocities * (t - self.ref_times)[:, None]
+        out = self.ref_positions + self.velocities * (t - self.ref_times)[:, None]
+        falls = self.falls
+        if falls is not None:  # the parabola, as the compiled frame computes it disc by disc
+            (x, y), (vx, vy) = self.ref_positions[falls].T, self.velocities[falls].T
+            out[falls, 0], out[falls, 1], _, _ = advance(x, y, vx, vy, t - self.ref_times[falls], *self.gravity)
+        return out
+
+    def velocities_at(self, t: float) -> np.ndarray:
+        """``(N, 2)`` velocities at time ``t`` on the current paths (a new array)."""
+        out = self.velocities.copy()
+        falls = self.falls
+        if falls is not None:
+            (x, y), (vx, vy) = self.ref_positions[falls].T, self.velocities[falls].T
+            _, _, out[falls, 0], out[falls, 1] = advance(x, y, vx, vy, t - self.ref_times[falls], *self.gravity)
+        return out
+
+    def fall(self, t: float, flown: np.ndarray) -> None:
+        """Under gravity, every disc that falls starts a new path at time ``t`` from ``flown`` (:meth:`flown` at
+        ``t``, not wrapped), with its velocity there: a frame's responses see the velocities at the frame."""
+        falls = self.falls
+        if falls is None:
+            return
+        self.velocities[falls] = self.velocities_at(t)[falls]
+        self.ref_positions[falls] = flown[falls]
+        self.ref_times[falls] = t
 
     def restart(self, rows, positions, t: float, flown=None) -> None:
         """Discs ``rows`` start new paths at time ``t`` from ``positions`` (their velocities set apart).
@@ -113,6 +163,8 @@ class Paths:
 
     def unwrapped(self, t: float) -> np.ndarray:
         """``(N, 2)`` positions at time ``t``, each disc followed across the edges of a periodic box."""
+        if self.falls is not None:
+            return self.flown(t) + self.images * self.box.size
         return self.ref_positions + self.images * self.box.size + self.velocities * (t - self.ref_times)[:, None]
 
 
@@ -125,13 +177,18 @@ class Tally:
         virial (float): the sum over the disc-disc impulses applied of ``dp_i . (r_i - r_j)`` (energy):
             ``dp_i`` the momentum disc ``i`` receives, ``r_i - r_j`` the minimum-image separation of the
             pair where the impulse is applied (see :func:`impulse_virial`).
+        dissipated (float): the kinetic energy the responses with restitution below 1 took (energy).
         log (EventLog or None): where responses are logged (None: not recorded).
     """
 
     NAMES = ("frames", "pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits", "list_builds")
 
-    def __init__(self, counts: dict[str, int] | None = None, max_overlap: float = 0.0, virial: float = 0.0):
+    def __init__(
+        self, counts: dict[str, int] | None = None, max_overlap: float = 0.0, virial: float = 0.0,
+        dissipated: float = 0.0,
+    ):  # fmt: skip
         self.counts = {name: 0 for name in self.NAMES} if counts is None else {n: int(counts[n]) for n in self.NAMES}
         self.max_overlap = float(max_overlap)
         self.virial = float(virial)
+        self.dissipated = float(dissipated)
         self.log: EventLog | None = None

@@ -11,9 +11,13 @@ answers with one of five policies, chosen once when the engine is built:
 
 Between responses discs fly straight, so the event log (one record per response, with the state just
 after it) rebuilds the exact path the engine took, and ``trajectory()`` works as for the event-driven
-engine. The broad phase (:mod:`~discsim.engines.fixed_step.broad_phase`) is a Verlet list on a cell grid
-or every pair; both give identical runs. Collision filtering (``pass_through``) drops the pairs of groups
-that pass through each other before the narrow phase, under every policy.
+engine. The laws of :class:`~discsim.engines.event_driven.EventDriven` apply too (``gravity=``,
+``restitution=``, ``tc=``): under gravity every disc of finite mass follows the exact parabola over a frame
+(:func:`~discsim.physics.dynamics.advance`; ``trajectory()`` adds the fall since each disc's last record),
+and the responses apply the restitution through the same collision law (:mod:`discsim.physics.laws`).
+The broad phase (:mod:`~discsim.engines.fixed_step.broad_phase`) is a Verlet list on a cell grid or every
+pair; both give identical runs. Collision filtering (``pass_through``) drops the pairs of groups that pass
+through each other before the narrow phase, under every policy.
 
 :class:`FixedStep` is the front: it validates the scene and the options, owns the public API, the event
 log and the frame clock, and hands each frame to its policy, which works on the state arrays
@@ -47,6 +51,7 @@ from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisec
 from discsim.engines.record import collision_virials
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
+from discsim.laws import Laws
 from discsim.model import Box, Discs, frame_count
 from discsim.scene import Scene
 
@@ -99,10 +104,18 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             imports, else ``"python"``),
             ``"numba"`` (the frame compiled, from the ``fast`` extra: ``pip install
             "discsim[fast]"``) or ``"python"`` (numpy). Both give the same frames bit for bit.
+        gravity, restitution, tc: the laws of :class:`~discsim.engines.event_driven.EventDriven`, alike:
+            ``(gx, gy)`` (length / time^2; None: none) moves each disc of finite mass along the exact parabola
+            over a frame (``x += v dt + g dt^2 / 2``, ``v += g dt``; the frame policies only: ``"bisect"`` and
+            ``"swept"`` follow straight paths inside a frame and refuse it); ``e`` in [0, 1] (or per pair of
+            groups) at every response, the energy taken in :attr:`dissipated`; the TC time (0: none).
+        rest_speed: checked as ``EventDriven`` checks it, and ignored: PIT has no rest (a disc on a floor
+            keeps bouncing from frame to frame).
 
     Raises:
         InvalidArgumentError: on a frame rate, ``dt`` or ``bisect_tol`` that is
-            not a positive finite number, both of ``frame_rate`` and ``dt`` given
+            not a positive finite number, a law refused as ``EventDriven`` refuses it, gravity with a
+            sub-frame policy, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
             a periodic box, ``backend="numba"`` without numba (naming the extra to
             install).
@@ -166,6 +179,10 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         pass_through=(),
         bisect_tol: float | None = None,
         backend: str = "auto",
+        gravity=None,
+        restitution=1.0,
+        tc: float = 0.0,
+        rest_speed: float | None = None,
     ):
         if dt is None:
             rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
@@ -185,17 +202,20 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
+        laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed), policy)
         backend = _choose_backend(backend, policy)
-        self._configure(
-            Scene(discs, box, segments, pass_through), record, rate, step, by_rate, policy, broad_phase, tol, backend
-        )
+        scene = Scene(discs, box, segments, pass_through)
+        self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws)
         self._load(self._initial_state())
 
-    def _configure(self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend) -> None:
+    def _configure(
+        self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend, laws
+    ) -> None:
         """Build the parts the options choose (checked already; ``backend`` resolved); the run state comes
         from :meth:`_load`.
         """
         super().__init__(scene, record)
+        self.laws = laws
         self.frame_rate = frame_rate
         self.dt = dt
         self._by_rate = by_rate  # frame k at k / frame_rate, else at k * dt
@@ -207,7 +227,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
 
     def _parts(self, scene: Scene) -> tuple:
         """``(shapes, broad phase, policy)`` for the discs of ``scene`` (options set already)."""
-        shapes = Shapes(scene)
+        shapes = Shapes(scene, self.laws)
         # The same box check as EventDriven's cell grid (a periodic box needs 3 cells a side);
         # max_cells=9 keeps the throw-away grid tiny.
         CellGrid(scene.box, shapes.diameter, max_cells=9)
@@ -226,7 +246,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         next frame."""
         parts = self._parts(scene)  # may refuse the new discs: nothing changed
         state = self.state()
-        arrays = {name: getattr(state, name)[keep] for name in ("ref_positions", "velocities", "ref_times")}
+        arrays = {n: getattr(state, n)[keep] for n in ("ref_positions", "velocities", "ref_times", "last_collision")}
         arrays.update(images=state.images[keep], frame_positions=state.frame_positions[keep])
         if added is not None:
             k, t = len(added), self.time
@@ -234,6 +254,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
                 ("ref_positions", added.positions),
                 ("velocities", added.velocities),
                 ("ref_times", np.full(k, t)),
+                ("last_collision", np.full(k, -np.inf)),
                 ("images", np.zeros((k, 2), dtype=np.int64)),
                 ("frame_positions", added.positions),
             ):
@@ -257,6 +278,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             "bisect_tol": self.bisect_tol,
             "backend": self.backend,
             "edits": self._edits,
+            **({} if self.laws.default and self.laws.tc == 0.0 else {"laws": self.laws.settings()}),
         }
 
     @classmethod
@@ -279,6 +301,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             settings["broad_phase"],
             float(settings["bisect_tol"]),
             backend,
+            _restored_laws(settings),
         )
         sim.start_time = start_time
         sim._edits = int(settings.get("edits", 0))
@@ -453,6 +476,35 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             raise
         self._frame_time = self.time = float(times[-1])
         tally.counts["frames"] = k + count
+
+
+def _restored_laws(settings: dict) -> Laws:
+    """The laws a checkpoint's settings hold (none: the defaults), checked as the constructor checks them.
+
+    Raises:
+        CheckpointError: naming what the constructor would refuse.
+    """
+    try:
+        return _check_laws(Laws.from_settings(settings.get("laws", {})), settings["policy"])
+    except InvalidArgumentError as exc:
+        msg = f"the checkpoint's laws cannot be used: {exc}"
+        raise CheckpointError(msg) from exc
+
+
+def _check_laws(laws: Laws, policy: str) -> Laws:
+    """``laws``, unless ``policy`` cannot follow them: gravity inside a frame (the sub-frame policies' paths are
+    straight).
+
+    Raises:
+        InvalidArgumentError: naming the gravity and the policy.
+    """
+    if laws.falls and policy in SUB_FRAME_POLICIES:
+        msg = (
+            f"gravity={laws.gravity} needs a policy that answers at the frame ('resolve', 'revert' or 'separate'): "
+            f"policy {policy!r} finds contacts inside a frame along straight paths"
+        )
+        raise InvalidArgumentError(msg)
+    return laws
 
 
 def _choose_backend(backend, policy: str) -> str:

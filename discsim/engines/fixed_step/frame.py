@@ -28,10 +28,11 @@ import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BroadPhase
-from discsim.engines.fixed_step.parts import impulse_virial, push_off_segment, separate_pair
+from discsim.engines.fixed_step.parts import impulse_virial, kinetic_loss, push_off_segment, restitution, separate_pair
 from discsim.events import Event
 from discsim.kernels import closest_point_on_segment, reflect_off_segment, resolve_collision
 from discsim.model import minimum_image_1d
+from discsim.physics.laws import reflect
 
 __all__ = [
     "FRAME_POLICY_CLASSES",
@@ -107,6 +108,7 @@ class FramePolicy(Policy):
         box = self.shapes.box
         prev = paths.frame_positions
         flown = paths.flown(t)
+        paths.fall(t, flown)  # under gravity: the velocities at the frame
         pos = box.wrap(flown)
         events: list[Event] = []
         if not box.periodic:
@@ -125,11 +127,12 @@ class FramePolicy(Policy):
         """Where discs ``rows`` found past a wall (``low``, ``high``: see :func:`walls_crossed`) are left."""
         return pos
 
-    def off_segments(self, x, y, vx, vy, previous, hits, r):
+    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0):
         """Answer one disc at ``(x, y)`` moving at ``(vx, vy)`` that cuts segments ``hits`` (end point tuples).
 
         The segments are visited in order, each seeing the position and velocity the one before left
-        (a disc in a corner may touch two). ``previous``: the disc's ``(2,)`` position at the previous frame.
+        (a disc in a corner may touch two). ``previous``: the disc's ``(2,)`` position at the previous frame;
+        ``e``: the restitution of its bounces.
 
         Returns:
             ``(x, y, vx, vy, responded)``.
@@ -141,7 +144,7 @@ class FramePolicy(Policy):
             if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
             x, y = self.off_segment(x, y, qx, qy, nx, ny, r)
-            vx, vy = reflect_off_segment(x, y, vx, vy, *ends)
+            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e=e)
             responded = True
         return x, y, vx, vy, responded
 
@@ -168,14 +171,15 @@ class FramePolicy(Policy):
     # --- the frame, step by step ----------------------------------------------------------------------------
     def _walls(self, t, prev, pos, paths, tally, events) -> np.ndarray:
         """Discs past a wall and still moving outwards: reverse the normal velocity; return the positions."""
+        shapes = self.shapes
         vel = paths.velocities
-        size = self.shapes.box.size
-        low, high = walls_crossed(pos, vel, self.shapes.radii, size)
+        size = shapes.box.size
+        low, high = walls_crossed(pos, vel, shapes.radii, size)
         hit = low | high
         if not hit.any():
             return pos
-        vel[hit] = -vel[hit]
         rows = np.flatnonzero(hit.any(axis=1))
+        self._reflect_off_walls(t, rows, hit, paths, tally)
         pos = self.off_walls(pos, prev, rows, low, high, self.shapes.radii[:, None], size)
         paths.restart(rows, pos[rows], t)  # a walled box: no images
         tally.counts["wall_hits"] += len(rows)
@@ -186,22 +190,44 @@ class FramePolicy(Policy):
                 log.wall(t, i, *pos[i].tolist(), *vel[i].tolist())
         return pos
 
+    def _reflect_off_walls(self, t, rows, hit, paths, tally) -> None:
+        """Reverse the normal velocity of discs ``rows`` along each axis ``hit`` ``(N, 2)``, with restitution."""
+        shapes, vel, last = self.shapes, paths.velocities, paths.last_collision
+        e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
+        for i, (vx, vy), (hit_x, hit_y) in zip(rows.tolist(), vel[rows].tolist(), hit[rows].tolist()):
+            e = restitution(i, i, t, e0, per_group, table, group, tc, last)
+            ux, uy = reflect(vx, vy, 0, e) if hit_x else (vx, vy)
+            if hit_y:
+                ux, uy = reflect(ux, uy, 1, e)
+            vel[i] = (ux, uy)
+            if e != 1.0:
+                tally.dissipated += kinetic_loss(shapes.masses[i], vx, vy, ux, uy)
+            if tc > 0.0:
+                last[i] = t
+
     def _segments(self, t, prev, pos, paths, tally, events) -> None:
         """Discs cutting a segment at ``pos``; updates ``pos`` and the paths in place."""
         rows, cols = segments_cut(pos, self.shapes, tally.counts)
         if not len(rows):
             return
-        vel = paths.velocities
-        radius, ends = self.shapes.radius, self.shapes.seg_ends
+        shapes = self.shapes
+        vel, last = paths.velocities, paths.last_collision
+        radius, ends = shapes.radius, shapes.seg_ends
+        e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
         log = tally.log
         by_disc: dict[int, list[tuple]] = {}
         for i, k in zip(rows.tolist(), cols.tolist()):
             by_disc.setdefault(i, []).append(ends[k])
         for i, hits in by_disc.items():
             x, y = pos[i].tolist()
-            vx, vy = vel[i].tolist()
-            x, y, vx, vy, responded = self.off_segments(x, y, vx, vy, prev[i], hits, radius[i])
+            wx, wy = vel[i].tolist()
+            e = restitution(i, i, t, e0, per_group, table, group, tc, last)
+            x, y, vx, vy, responded = self.off_segments(x, y, wx, wy, prev[i], hits, radius[i], e)
             if responded:
+                if e != 1.0:
+                    tally.dissipated += kinetic_loss(shapes.masses[i], wx, wy, vx, vy)
+                if tc > 0.0:
+                    last[i] = t
                 pos[i] = (x, y)
                 vel[i] = (vx, vy)
                 paths.restart(i, (x, y), t)  # a walled box: no images
@@ -242,7 +268,8 @@ class FramePolicy(Policy):
         mass, radius = shapes.masses, shapes.radius
         box = shapes.box
         periodic, width, height = box.periodic, box.width, box.height
-        vel = paths.velocities
+        vel, last = paths.velocities, paths.last_collision
+        e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
         log = tally.log
         involved = np.unique(np.concatenate([ii, jj]))
         keys = involved.tolist()
@@ -267,7 +294,15 @@ class FramePolicy(Policy):
             before_i, before_j = (before[i], before[j]) if before is not None else (None, None)
             sigma = radius[i] + radius[j]
             xi, yi, xj, yj, dx, dy = self.contact(xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, before_i, before_j)
-            uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+            e = restitution(i, j, t, e0, per_group, table, group, tc, last)
+            uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj, e)
+            if e != 1.0:
+                tally.dissipated += kinetic_loss(mi, vxi, vyi, uxi, uyi) + kinetic_loss(mj, vxj, vyj, uxj, uyj)
+            if tc > 0.0:  # the TC model's clocks (an obstacle keeps none, as in EventDriven)
+                if shapes.moving[i]:
+                    last[i] = t
+                if shapes.moving[j]:
+                    last[j] = t
             sx, sy = xj - xi, yj - yi  # where the impulse is applied (moved there by "revert" or "separate")
             if periodic:
                 sx, sy = minimum_image_1d(sx, width), minimum_image_1d(sy, height)
@@ -305,7 +340,7 @@ class Revert(FramePolicy):
         pos[rows] = prev[rows]
         return pos
 
-    def off_segments(self, x, y, vx, vy, previous, hits, r):
+    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0):
         reverted = False
         responded = False
         for ends in hits:
@@ -321,12 +356,12 @@ class Revert(FramePolicy):
                     fx, fy = x, y
                     x, y = px, py
                     reverted = True
-                    vx, vy = reflect_off_segment(fx, fy, vx, vy, *ends)
+                    vx, vy = reflect_off_segment(fx, fy, vx, vy, *ends, e=e)
                     responded = True
                     continue
             if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
-            vx, vy = reflect_off_segment(x, y, vx, vy, *ends)
+            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e=e)
             responded = True
         return x, y, vx, vy, responded
 

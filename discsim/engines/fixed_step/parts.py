@@ -13,7 +13,9 @@ very source (``discsim._compiled.compile_from_source``), so the two cannot drift
   discs, or a disc cutting a segment (the caller passes the distance: Python's ``math.hypot`` is not the C
   library's, so the compiled frames pass CPython's, ``numba.kernels.cpython_hypot``);
 - :func:`table_shape` and :func:`cell_span`: the cells of the sub-frame policies' cell table
-  (:class:`~discsim.engines.fixed_step.broad_phase.CellTable`) and the cells a box meets.
+  (:class:`~discsim.engines.fixed_step.broad_phase.CellTable`) and the cells a box meets;
+- :func:`restitution` and :func:`kinetic_loss`: the coefficient of restitution of one response (one number,
+  or the pair of groups', 1 within the TC time) and the kinetic energy it takes from one disc.
 
 The free flight, the collision law and the times of impact are the physics parts themselves
 (:mod:`discsim.physics.dynamics`, :mod:`discsim.physics.laws`, :mod:`discsim.physics.sources`).
@@ -29,8 +31,10 @@ __all__ = [
     "box_image",
     "cell_span",
     "impulse_virial",
+    "kinetic_loss",
     "nearest_image",
     "push_off_segment",
+    "restitution",
     "separate_pair",
     "table_shape",
     "wrap",
@@ -194,3 +198,34 @@ def cell_span(lo: float, hi: float, size: float, count: int, periodic: bool) -> 
             return 0, count - 1, False
         return first, last, True
     return min(max(first, 0), count - 1), min(max(last, 0), count - 1), False
+
+
+def restitution(i: int, j: int, now: float, e: float, per_group: bool, table, group, tc: float, last) -> float:
+    """The coefficient of restitution of a response of discs ``i`` and ``j`` (``i`` twice: a wall or a segment)
+    at time ``now``: ``e``, or ``table[group[i], group[j]]`` when it depends on the pair of groups
+    (:meth:`discsim.laws.Laws.table`); 1 (elastic) when either disc's last response was within ``tc`` of ``now``
+    (the TC model; ``last``: each disc's last response time, ``-inf`` for none; ``tc = 0``: no TC model).
+
+    Example:
+        >>> restitution(0, 1, 5.0, 0.5, False, None, None, 0.0, None)
+        0.5
+        >>> restitution(0, 1, 5.0, 0.5, True, [[1.0, 0.2], [0.2, 0.9]], [0, 1], 0.1, [4.0, 4.95])  # TC: elastic
+        1.0
+    """
+    if per_group:
+        e = table[group[i]][group[j]]
+    if tc > 0.0 and (now - last[i] < tc or now - last[j] < tc):
+        e = 1.0
+    return e
+
+
+def kinetic_loss(m: float, vx: float, vy: float, ux: float, uy: float) -> float:
+    """The kinetic energy a disc of mass ``m`` loses going from velocity ``v`` to ``u`` (0 for an obstacle).
+
+    Example:
+        >>> kinetic_loss(2.0, 3.0, 0.0, 1.0, 0.0)
+        8.0
+    """
+    if m == INF:
+        return 0.0
+    return 0.5 * m * ((vx * vx + vy * vy) - (ux * ux + uy * uy))

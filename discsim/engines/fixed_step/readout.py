@@ -1,4 +1,5 @@
-"""What a fixed-step run shows: positions and velocities at any time, the counters, the pressure, the frame clock.
+"""What a fixed-step run shows: positions and velocities at any time, the counters, the pressure, the energies,
+the trajectory under gravity, the frame clock.
 
 :class:`FrameReadout` is the read-only side of :class:`~discsim.engines.fixed_step.engine.FixedStep`: it reads
 the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and changes nothing.
@@ -7,13 +8,14 @@ the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Tally
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.errors import InvalidArgumentError
-from discsim.model import Box, _readonly
+from discsim.laws import Laws
+from discsim.model import Box, Discs, _readonly
 
 __all__ = ["FrameReadout"]
 
@@ -23,6 +25,8 @@ class FrameReadout:
 
     # What the engine provides (declared for readers and the type checker).
     box: Box
+    discs: Discs
+    laws: Laws
     time: float
     start_time: float
     frame_rate: float
@@ -31,10 +35,15 @@ class FrameReadout:
     _frame_time: float
     _paths: Paths
     _tally: Tally
+    _shapes: Shapes
+    run_context: Any
 
     if TYPE_CHECKING:
 
         def kinetic_energy(self) -> float: ...  # Engine's
+
+        @property
+        def events(self) -> np.ndarray: ...  # EventRecord's
 
     @property
     def frames(self) -> int:
@@ -77,8 +86,36 @@ class FrameReadout:
 
     @property
     def velocities(self) -> np.ndarray:
-        """``(N, 2)`` velocities at ``time`` (a fresh copy)."""
+        """``(N, 2)`` velocities at ``time`` (a fresh copy; under gravity, between frames, on the parabola)."""
+        if self._paths.falls is not None and self.time != self._frame_time:
+            return _readonly(self._paths.velocities_at(self.time))
         return _readonly(self._paths.velocities.copy())
+
+    @property
+    def dissipated(self) -> float:
+        """Kinetic energy taken since the start by the responses with restitution below 1 (0 for elastic discs).
+
+        Only the collision law's loss: what the frames' own errors add or take (a disc that sinks into the
+        floor before its bounce, ``"separate"`` lifting it out, ``"revert"`` sending it back) is not counted,
+        so ``energy() + dissipated`` drifts from its start by the stepping's error alone.
+        """
+        return self._tally.dissipated
+
+    def potential_energy(self) -> float:
+        """The potential energy in the gravity field, ``-sum(m g . r)`` over the discs of finite mass (zero at the
+        origin of the box; 0 without gravity). ``r`` is the unwrapped centre in a periodic box. Units: mass
+        length^2 / time^2."""
+        if not self.laws.falls:
+            return 0.0
+        masses = self.discs.masses
+        finite = np.isfinite(masses)
+        g = np.array(self.laws.gravity)
+        return float(-np.sum(masses[finite] * (self.unwrapped_positions[finite] @ g)))
+
+    def energy(self) -> float:
+        """Kinetic plus potential energy. An exact run would keep it with ``restitution=1``; a fixed-step run
+        changes it by the stepping's error (see :attr:`dissipated`)."""
+        return self.kinetic_energy() + self.potential_energy()
 
     def pressure(self) -> float:
         """Pressure from the virial of the impulses the frames applied, averaged since the start.
@@ -117,6 +154,12 @@ class FrameReadout:
         if elapsed <= 0:
             msg = "pressure() needs a run of positive duration"
             raise InvalidArgumentError(msg)
+        if self.laws.falls:
+            msg = (
+                f"pressure() is the bulk pressure of a uniform gas; under gravity {self.laws.gravity} the "
+                "pressure varies with height (measure the density profile instead)"
+            )
+            raise InvalidArgumentError(msg)
         virial = self._tally.virial
         if math.isnan(virial):
             msg = (
@@ -125,6 +168,42 @@ class FrameReadout:
             )
             raise InvalidArgumentError(msg)
         return (self.kinetic_energy() + virial / (2.0 * elapsed)) / self.box.area
+
+    def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
+        """Positions ``(T, N, 2)`` at ``times`` ``(T,)``, rebuilt from the event log (see
+        :meth:`~discsim.engines.record.EventRecord.trajectory`).
+
+        Under gravity each disc of finite mass follows its parabola from its last record (the log's straight
+        path plus ``g dt^2 / 2``, ``dt`` the time since that record): the engine's own positions at the
+        frames, to rounding.
+
+        Raises:
+            InvalidArgumentError: as the log's trajectory; and under gravity, after ``add_discs`` or
+                ``remove_discs`` (not rebuilt).
+        """
+        out = super().trajectory(times, unwrapped=unwrapped)  # type: ignore[misc]  # the log's (EventRecord)
+        falls = self._shapes.falls
+        if not falls.any():
+            return out
+        if self.run_context.origin is not None:
+            msg = "trajectory() under gravity is not rebuilt after add_discs or remove_discs"
+            raise InvalidArgumentError(msg)
+        asked = np.atleast_1d(np.asarray(times, dtype=float))
+        events = self.events
+        g = np.array(self.laws.gravity)
+        for d in np.flatnonzero(falls).tolist():
+            records = events["time"][(events["i"] == d) | (events["j"] == d)]  # in time order
+            last = np.concatenate([[self.start_time], records])[np.searchsorted(records, asked, side="right")]
+            since = asked - last
+            out[:, d] += 0.5 * g * (since * since)[:, None]
+        if self.box.periodic and not unwrapped:
+            out = self.box.wrap(out)
+        return out
+
+    def _gravity(self):
+        """None: the log's trajectory is rebuilt in free flight, and :meth:`trajectory` adds the fall (a PIT run
+        has no rest, so the event-driven rule "a record of zero velocity rests" must not apply)."""
+        return None
 
     def frame_time(self, k):
         """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""

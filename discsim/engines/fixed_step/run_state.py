@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from discsim.engines.fixed_step.arrays import Paths, Tally
+from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.state import FixedStepState
 from discsim.errors import CheckpointError
 from discsim.model import Box, Discs
@@ -32,6 +32,7 @@ class FixedStepRun:
     _paths: Paths
     _tally: Tally
     _broad: Any
+    _shapes: Shapes
 
     def _initial_state(self) -> FixedStepState:
         discs = self.discs
@@ -53,6 +54,7 @@ class FixedStepRun:
             list_positions=np.zeros((0, 2)),
             list_i=empty,
             list_j=empty,
+            last_collision=np.full(n, -np.inf),
         )
 
     def state(self) -> FixedStepState:
@@ -79,6 +81,8 @@ class FixedStepRun:
             list_positions=list_positions,
             list_i=list_i,
             list_j=list_j,
+            dissipated=float(self._tally.dissipated),
+            last_collision=paths.last_collision.copy(),
         )
 
     def _load(self, state: FixedStepState) -> None:
@@ -91,14 +95,16 @@ class FixedStepRun:
             ("ref_times", np.float64, (n,)),
             ("images", np.int64, (n, 2)),
             ("frame_positions", np.float64, (n, 2)),
+            ("last_collision", np.float64, (n,)),
         ):
             array = np.array(getattr(state, name), dtype=dtype)
             if array.shape != shape:
                 msg = f"FixedStepState.{name} has shape {array.shape}; {shape} expected for {n} discs"
                 raise CheckpointError(msg)
             arrays[name] = array
-        self._paths = Paths(self.box, **arrays)
-        self._tally = Tally(state.counts, state.max_overlap, state.virial)
+        shapes = self._shapes
+        self._paths = Paths(self.box, **arrays, gravity=shapes.gravity, falls=shapes.falls)
+        self._tally = Tally(state.counts, state.max_overlap, state.virial, state.dissipated)
         built = state.list_builds > 0 and len(state.list_positions) == n  # not after add_discs / remove_discs
         self._broad.load(state.list_positions, state.list_i, state.list_j, built=built)
         self._frame_time = float(state.frame_time)

@@ -18,7 +18,7 @@ __all__ = ["FixedStepState"]
 
 @dataclass(eq=False)
 class FixedStepState(EngineState):
-    """Everything a fixed-step run needs to continue bit for bit (version 2).
+    """Everything a fixed-step run needs to continue bit for bit (version 3).
 
     Per-disc arrays are indexed as ``discs``. Frame ``k`` falls at ``start_time + k / frame_rate`` (or
     ``start_time + k * dt``, as the engine was built), so the frame count fixes the frame times.
@@ -32,23 +32,28 @@ class FixedStepState(EngineState):
         max_overlap: the deepest disc-disc overlap seen, as a fraction of the contact distance.
         virial: the sum over the disc-disc impulses applied since the start of ``dp_i . (r_i - r_j)``
             (energy; ``FixedStep.pressure()``); NaN when unknown (a version 1 state: see below).
+        dissipated: the kinetic energy taken by responses with restitution below 1 (``FixedStep.dissipated``).
 
     Arrays:
         ref_positions ``(N, 2)``, velocities ``(N, 2)``, ref_times ``(N,)``:
             disc ``i`` is at ``ref_positions[i] + velocities[i] (t - ref_times[i])``
-            (lengths, length per time, times; not wrapped).
+            (lengths, length per time, times; not wrapped); under gravity a disc of finite mass follows the
+            parabola from there (``discsim.physics.dynamics.advance``), ``velocities[i]`` its velocity at
+            ``ref_times[i]``.
         images ``(N, 2)`` int64: box lengths to add to ``ref_positions`` to unwrap them
             (zero in a walled box).
         frame_positions ``(N, 2)``: the positions at ``frame_time``, wrapped into a periodic box.
         list_positions ``(N, 2)``: where the discs were when the Verlet list of the ``"grid"``
             broad phase was last built, or ``(0, 2)`` if it never was (``list_builds == 0``).
         list_i, list_j ``(P,)`` int64: the pairs of discs in that list.
+        last_collision ``(N,)``: each disc's last response time (``-inf``: none), for the TC model.
 
     Versions: 1 had no ``virial``; it is read with ``virial = NaN`` (:meth:`from_arrays`), which
-    ``FixedStep`` rebuilds from the event log when the log covers the whole run.
+    ``FixedStep`` rebuilds from the event log when the log covers the whole run. 1 and 2 had no laws
+    (``dissipated``, ``last_collision``): they are read with their defaults, 0 and ``-inf``.
     """
 
-    VERSION = 2
+    VERSION = 3
 
     time: float
     frame_time: float
@@ -69,12 +74,25 @@ class FixedStepState(EngineState):
     list_positions: np.ndarray
     list_i: np.ndarray
     list_j: np.ndarray
+    dissipated: float = 0.0
+    last_collision: np.ndarray = None  # type: ignore[assignment]  # None: no response yet (filled in below)
+
+    def __post_init__(self) -> None:
+        if self.last_collision is None:
+            self.last_collision = np.full(len(self.ref_times), -np.inf)
 
     @classmethod
     def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int) -> FixedStepState:
-        """As :meth:`EngineState.from_arrays`; a version 1 state (before ``virial``) gets ``virial = NaN``."""
+        """As :meth:`EngineState.from_arrays`; a version 1 state (before ``virial``) gets ``virial = NaN``, and a
+        version 1 or 2 state (before the laws) ``dissipated = 0`` and no last responses."""
         if version == 1 and "virial" not in scalars:
-            return super().from_arrays({**scalars, "virial": math.nan}, arrays, cls.VERSION)
+            scalars = {**scalars, "virial": math.nan}
+            version = 2
+        if version == 2:
+            n = len(arrays.get("ref_times", ()))
+            scalars = {**scalars, "dissipated": 0.0}
+            arrays = {**arrays, "last_collision": np.full(n, -np.inf)}
+            version = cls.VERSION
         return super().from_arrays(scalars, arrays, version)
 
     @property

@@ -36,7 +36,7 @@ import numpy as np
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import AllDiscs, BroadPhase, CellTable
 from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
-from discsim.engines.fixed_step.parts import impulse_virial
+from discsim.engines.fixed_step.parts import impulse_virial, kinetic_loss, restitution
 from discsim.errors import InvalidArgumentError, JammedError
 from discsim.events import Event, EventKind
 from discsim.kernels import (
@@ -50,6 +50,7 @@ from discsim.kernels import (
 )
 from discsim.model import minimum_image_1d
 from discsim.physics.dynamics import advance
+from discsim.physics.laws import reflect
 
 __all__ = ["SUB_FRAME_POLICY_CLASSES", "Bisect", "SubFrame", "SubFramePolicy", "Swept"]
 
@@ -262,7 +263,14 @@ class SubFrame:
         sigma = shapes.radius[a] + shapes.radius[b]
         self.tally.max_overlap = max(self.tally.max_overlap, 1.0 - math.hypot(dx, dy) / sigma)
         ma, mb = shapes.masses[a], shapes.masses[b]
-        uxa, uya, uxb, uyb = resolve_collision(dx, dy, vxa, vya, vxb, vyb, ma, mb)
+        e = self._restitution(a, b, tc)
+        uxa, uya, uxb, uyb = resolve_collision(dx, dy, vxa, vya, vxb, vyb, ma, mb, e)
+        if e != 1.0:
+            self.tally.dissipated += kinetic_loss(ma, vxa, vya, uxa, uya) + kinetic_loss(mb, vxb, vyb, uxb, uyb)
+        if shapes.tc > 0.0:  # the TC model's clocks (an obstacle keeps none, as in EventDriven)
+            for d in (a, b):
+                if shapes.moving[d]:
+                    self.paths.last_collision[d] = tc
         self.tally.virial += impulse_virial(dx, dy, vxa, vya, uxa, uya, vxb, vyb, uxb, uyb, ma, mb)
         moving = shapes.moving
         if moving[a]:
@@ -285,23 +293,34 @@ class SubFrame:
         v = (vx, vy)[axis]
         if (v <= 0.0) if high else (v >= 0.0):  # moving away from this wall already
             return
-        if axis == 0:
-            vx = -vx
-        else:
-            vy = -vy
-        self._reflected(tc, a, x, y, vx, vy, WALL, wall)
+        e = self._restitution(a, a, tc)
+        ux, uy = reflect(vx, vy, axis, e)
+        self._reflected(tc, a, x, y, vx, vy, ux, uy, e, WALL, wall)
 
     def _segment(self, tc: float, a: int, k: int) -> None:
         x, y = self.at(a, tc)
         vx, vy = self.paths.velocities[a].tolist()
-        ends = self.shapes.seg_ends[k]
-        qx, qy = closest_point_on_segment(x, y, *ends)
+        ax, ay, bx, by = self.shapes.seg_ends[k]
+        qx, qy = closest_point_on_segment(x, y, ax, ay, bx, by)
         if vx * (x - qx) + vy * (y - qy) >= 0.0:  # receding
             return
-        vx, vy = reflect_off_segment(x, y, vx, vy, *ends)
-        self._reflected(tc, a, x, y, vx, vy, SEGMENT, k)
+        e = self._restitution(a, a, tc)
+        ux, uy = reflect_off_segment(x, y, vx, vy, ax, ay, bx, by, e)
+        self._reflected(tc, a, x, y, vx, vy, ux, uy, e, SEGMENT, k)
 
-    def _reflected(self, tc, a, x, y, vx, vy, kind: EventKind, other: int) -> None:
+    def _restitution(self, a: int, b: int, now: float) -> float:
+        """The restitution of a response of discs ``a`` and ``b`` (``a`` twice: a wall or segment) at ``now``."""
+        shapes = self.shapes
+        return restitution(
+            a, b, now, shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc, self.paths.last_collision
+        )
+
+    def _reflected(self, tc, a, x, y, wx, wy, vx, vy, e, kind: EventKind, other: int) -> None:
+        """Disc ``a`` bounced at ``tc`` at ``(x, y)`` from velocity ``(wx, wy)`` to ``(vx, vy)`` (restitution ``e``)."""
+        if e != 1.0:
+            self.tally.dissipated += kinetic_loss(self.shapes.masses[a], wx, wy, vx, vy)
+        if self.shapes.tc > 0.0:
+            self.paths.last_collision[a] = tc
         x, y = self._turn(a, tc, x, y, vx, vy)
         self.counts["wall_hits"] += 1
         self.events.append(Event(tc, "wall", a, -1))

@@ -211,11 +211,20 @@ def test_the_defaults_are_todays_physics():
         ({"gravity": "down"}, "gravity"),
         ({"tc": -1.0}, "tc"),
         ({"rest_speed": -1.0}, "rest_speed"),
+        ({"rest_speed": 0.0}, "rest_speed"),
     ],
 )
 def test_bad_laws_are_refused_naming_the_argument(kwargs, name):
     with pytest.raises(InvalidArgumentError, match=name):
         ds.EventDriven(ball(5.0, 5.0), BOX, **kwargs)
+
+
+def test_a_disc_at_rest_on_a_cell_edge_falls(every_backend):
+    # Its centre exactly on the edge between two rows of cells, at rest: it must leave the cell at once and fall.
+    sim = ds.EventDriven(ball(2.0, 4.5, r=0.5), ds.Box(4.0, 6.0), gravity=(0.0, -1.0), restitution=0.5)
+    sim.run(until=10.0)
+    assert sim.positions[0, 1] == pytest.approx(0.5) and sim.resting.all()
+    assert times(sim)[0] == pytest.approx(math.sqrt(2 * 4.0))
 
 
 def test_pressure_under_gravity_is_refused_with_a_reason():
@@ -268,3 +277,11 @@ def test_trajectories_follow_the_parabolas_and_the_rest(every_backend):
     rest = times(sim)[-1]
     assert sim.resting.all()
     assert sim.trajectory([rest, (rest + 5.0) / 2, 5.0])[:, 0].tolist() == [sim.positions[0].tolist()] * 3
+
+
+def test_replays_of_free_flight_refuse_a_run_under_gravity():
+    sim = ds.EventDriven(ball(5.0, 5.0, 1.0), BOX, gravity=(0.0, -G)).run(until=1.0)
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.frames(sim, [0.5])
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.view(sim)

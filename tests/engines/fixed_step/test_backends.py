@@ -71,6 +71,7 @@ def large():
 
 
 SCENES = {"walled": walled, "periodic": periodic, "large": large}
+BOTH = ("python", "numba")
 
 
 def assert_identical(a, b):
@@ -133,6 +134,23 @@ def test_the_sub_frame_policies_give_the_same_frames_bit_for_bit(scene, policy, 
         inside = (x - r > 1e-9) & (x + r < box.width - 1e-9) & (y - r > 1e-9) & (y + r < box.height - 1e-9)
         assert inside.any()
     assert_identical(*runs)
+
+
+@needs_numba
+@pytest.mark.parametrize("policy", COMPILED_POLICIES)
+@pytest.mark.parametrize("scene", ["walled", "periodic"])
+def test_both_backends_give_the_same_frames_under_gravity_and_restitution(scene, policy):
+    """Restitution per pair of groups, the TC model, gravity (the frame policies: the sub-frame ones refuse it):
+    the same log, state (the last responses too) and energy dissipated, bit for bit."""
+    discs, box, options = SCENES[scene]()
+    laws = {"restitution": {(0, 0): 0.7, (0, 1): 0.5, (1, 2): 0.9, (2, 2): 0.95}, "tc": 0.01}
+    if policy in FRAME_POLICIES:
+        laws["gravity"] = (0.3, -2.0)
+    runs = [ds.FixedStep(discs, box, policy=policy, backend=b, **options, **laws).run(frames=120) for b in BOTH]
+    assert runs[0].counts["detections"] > 500 and runs[0].dissipated > 0.0
+    assert np.isfinite(runs[0].state().last_collision).sum() > 10
+    assert_identical(*runs)
+    assert runs[0].dissipated == runs[1].dissipated and runs[0].energy() == runs[1].energy()
 
 
 @needs_numba

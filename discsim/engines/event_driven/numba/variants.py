@@ -118,7 +118,7 @@ def with_laws(*, interpreted: bool = False) -> dict:
             namespace[name] = rebuilt
         else:
             options = {key: value for key, value in dispatcher.targetoptions.items() if key != "nopython"}
-            namespace[name] = nb.njit(**options)(rebuilt)  # cache=True among the options: its own cache files
+            namespace[name] = nb.njit(cache=True, **options)(rebuilt)  # its own cache files, by its own name
     _LAWS_BUILT[interpreted] = namespace
     return namespace
 

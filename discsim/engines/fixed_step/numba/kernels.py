@@ -30,6 +30,7 @@ from discsim.model import image_step, minimum_image_1d
 from discsim.physics.compiled import advance
 from discsim.physics.compiled import closest_point_on_segment as _closest_point
 from discsim.physics.compiled import collide as _collide
+from discsim.physics.compiled import reflect as _reflect_wall
 from discsim.physics.compiled import reflect_off_segment as _reflect
 
 _nb = numba()
@@ -55,6 +56,8 @@ _parts = compile_from_source(
         parts.impulse_virial,
         parts.separate_pair,
         parts.push_off_segment,
+        parts.restitution,
+        parts.kinetic_loss,
     ),
     jit,
 )
@@ -65,6 +68,8 @@ _wrap = _parts[parts.wrap]
 _nearest_image = _parts[parts.nearest_image]  # the rule as the Python frames' scalar loops compute it
 _image = _parts[parts.box_image]  # as Box.minimum_image computes it on arrays (a zero as +0.0)
 _impulse_virial = _parts[parts.impulse_virial]
+_restitution = _parts[parts.restitution]
+_kinetic_loss = _parts[parts.kinetic_loss]
 
 #: The compiled policies by name: the ``policy`` argument of :func:`frames`.
 POLICY_CODES = {"resolve": 0, "revert": 1, "separate": 2}
@@ -180,23 +185,34 @@ def _log_wall(ev_n, ev_f, k, frame, i, x, y, vx, vy):
 
 # --- the steps of a frame --------------------------------------------------------------------------------
 @jit
-def _walls(policy, pos, prev, vel, radii, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame):
-    """Discs past a wall and moving outwards: reverse the normal velocity; returns ``(k, ev_n, ev_f)``."""
+def _walls(policy, pos, prev, vel, radii, masses, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws):
+    """Discs past a wall and moving outwards: reverse the normal velocity (with restitution); returns
+    ``(k, ev_n, ev_f)``."""
+    _, _, _, e0, per_group, table, group, tc, last, lost = laws
     for i in range(len(pos)):
         r = radii[i]
         hit = False
+        wx = wy = 0.0
+        e = 1.0
         for axis in range(2):
             size = width if axis == 0 else height
             p, v = pos[i, axis], vel[i, axis]
             low = p < r and v < 0.0
             high = p > size - r and v > 0.0
             if low or high:
+                if not hit:
+                    wx, wy = vel[i, 0], vel[i, 1]
+                    e = _restitution(i, i, t, e0, per_group, table, group, tc, last)
                 hit = True
-                vel[i, axis] = -v
+                vel[i, 0], vel[i, 1] = _reflect_wall(vel[i, 0], vel[i, 1], axis, e)
                 if policy == SEPARATE:
                     pos[i, axis] = r if low else size - r
         if not hit:
             continue
+        if e != 1.0:
+            lost[0] += _kinetic_loss(masses[i], wx, wy, vel[i, 0], vel[i, 1])
+        if tc > 0.0:
+            last[i] = t
         if policy == REVERT:
             pos[i, 0], pos[i, 1] = prev[i, 0], prev[i, 1]
         ref_pos[i, 0], ref_pos[i, 1] = pos[i, 0], pos[i, 1]
@@ -207,7 +223,7 @@ def _walls(policy, pos, prev, vel, radii, width, height, ref_pos, ref_t, t, ev_n
 
 
 @jit
-def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r):
+def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e):
     """One disc cutting the segments ``cut`` (in order): ``(x, y, vx, vy, responded)``.
 
     ``FramePolicy.off_segments`` (``"resolve"``, ``"separate"``) and ``Revert.off_segments``; ``(px, py)``
@@ -228,21 +244,22 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r):
                 fx, fy = x, y
                 x, y = px, py
                 reverted = True
-                vx, vy = _reflect(fx, fy, vx, vy, ax, ay, bx, by)
+                vx, vy = _reflect(fx, fy, vx, vy, ax, ay, bx, by, e)
                 responded = True
                 continue
         if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
             continue
         if policy == SEPARATE:
             x, y = _push_off_segment(x, y, qx, qy, nx, ny, r, cpython_hypot(nx, ny))
-        vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by)
+        vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by, e)
         responded = True
     return x, y, vx, vy, responded
 
 
 @jit
-def _segments(policy, pos, prev, vel, radii, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame):
+def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws):
     """Discs cutting a segment, each answered by :func:`_off_segments`; returns ``(k, ev_n, ev_f)``."""
+    _, _, _, e0, per_group, table, group, tc, last, lost = laws
     cut = np.empty(len(segments), dtype=np.int64)
     for i in range(len(pos)):
         x, y, r = pos[i, 0], pos[i, 1], radii[i]
@@ -253,10 +270,14 @@ def _segments(policy, pos, prev, vel, radii, segments, ref_pos, ref_t, t, ev_n, 
                 m += 1
         if m == 0:
             continue
-        x, y, vx, vy, responded = _off_segments(
-            policy, x, y, vel[i, 0], vel[i, 1], prev[i, 0], prev[i, 1], segments, cut[:m], r
-        )
+        wx, wy = vel[i, 0], vel[i, 1]
+        e = _restitution(i, i, t, e0, per_group, table, group, tc, last)
+        x, y, vx, vy, responded = _off_segments(policy, x, y, wx, wy, prev[i, 0], prev[i, 1], segments, cut[:m], r, e)
         if responded:
+            if e != 1.0:
+                lost[0] += _kinetic_loss(masses[i], wx, wy, vx, vy)
+            if tc > 0.0:
+                last[i] = t
             pos[i, 0], pos[i, 1] = x, y
             vel[i, 0], vel[i, 1] = vx, vy
             ref_pos[i, 0], ref_pos[i, 1] = x, y
@@ -495,7 +516,7 @@ def _contact(policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j
 
 
 @jit
-def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial):
+def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial, laws):
     """Answer the overlapping pairs in order (keys ``i * N + j``); returns ``(k, virial)``: the events
     written so far and the collision virial with these responses added.
 
@@ -504,6 +525,7 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
     """
     ref_pos, vel, ref_t, _ = paths
     radii, masses, periodic, width, height, _, _, _, _ = scene
+    _, _, _, e0, per_group, table, group, tc, last, lost = laws
     n = len(pos)
     for key in keys:
         i, j = key // n, key % n
@@ -520,7 +542,15 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
         xi, yi, xj, yj, dx, dy = _contact(
             policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j, periodic, width, height
         )
-        uxi, uyi, uxj, uyj = _collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj)
+        e = _restitution(i, j, t, e0, per_group, table, group, tc, last)
+        uxi, uyi, uxj, uyj = _collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj, e)
+        if e != 1.0:
+            lost[0] += _kinetic_loss(mi, vxi, vyi, uxi, uyi) + _kinetic_loss(mj, vxj, vyj, uxj, uyj)
+        if tc > 0.0:  # the TC model's clocks (an obstacle keeps none)
+            if mi != INF:
+                last[i] = t
+            if mj != INF:
+                last[j] = t
         sx, sy = xj - xi, yj - yi  # where the impulse is applied
         if periodic:
             sx, sy = _nearest_image(sx, width), _nearest_image(sy, height)
@@ -547,7 +577,7 @@ C_PAIR_TESTS, C_SEGMENT_TESTS, C_DETECTIONS, C_WALL_HITS, C_LIST_BUILDS = range(
 
 
 @jit
-def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap, virial):
+def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap, virial, laws):
     """One frame at time ``t`` (index ``frame`` in the batch): from ``frame_pos`` (the last frame's
     positions) to ``pos`` (written); see :func:`frames`.
 
@@ -556,22 +586,32 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
         buffer, the Verlet list, the deepest overlap and the collision virial.
     """
     ref_pos, vel, ref_t, images = paths
-    radii, _, periodic, width, height, segments, group, blocked, filtering = scene
+    radii, masses, periodic, width, height, segments, group, blocked, filtering = scene
     all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
+    gx, gy, falls = laws[0], laws[1], laws[2]
+    falling = gx != 0.0 or gy != 0.0  # (spares the free-flight loop a read of falls per disc)
     n = len(ref_pos)
-    for i in range(n):  # Paths.flown, then Box.wrap
-        x, y, _, _ = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i])
+    for i in range(n):  # Paths.flown and Paths.fall, then Box.wrap
+        if falling and falls[i]:  # under gravity: along the parabola, and a new path from the frame
+            x, y, vx, vy = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i], gx, gy)
+            vel[i, 0], vel[i, 1] = vx, vy
+            ref_pos[i, 0], ref_pos[i, 1] = x, y
+            ref_t[i] = t
+        else:
+            x, y, _, _ = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i])
         if periodic:
             x, y = _wrap(x, width), _wrap(y, height)
         pos[i, 0], pos[i, 1] = x, y
     first = k
     if not periodic:
         k, ev_n, ev_f = _walls(
-            policy, pos, frame_pos, vel, radii, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame
+            policy, pos, frame_pos, vel, radii, masses, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws
         )
     if len(segments):
         counts[C_SEGMENT_TESTS] += n * len(segments)
-        k, ev_n, ev_f = _segments(policy, pos, frame_pos, vel, radii, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame)
+        k, ev_n, ev_f = _segments(
+            policy, pos, frame_pos, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws
+        )
     counts[C_WALL_HITS] += k - first
     if not all_pairs and (len(list_pos) == 0 or _stale(pos, list_pos, periodic, width, height, limit2)):
         list_i, list_j = build_list(
@@ -588,7 +628,9 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
         changed = np.zeros(n, dtype=np.bool_)
         flown = np.empty((n if periodic else 0, 2))
         before = k
-        k, virial = _pairs(policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial)
+        k, virial = _pairs(
+            policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial, laws
+        )
         counts[C_DETECTIONS] += k - before
         for i in range(n):  # Paths.restart
             if not changed[i]:
@@ -605,7 +647,7 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
 
 
 @jit
-def frames(policy, times, scene, paths, broad, counts, overlap, virial):
+def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws):
     """Frames at ``times`` one after the other: move every disc to the frame, then answer what overlaps there.
 
     Changes the paths in place, as ``FramePolicy.frame`` changes
@@ -625,6 +667,11 @@ def frames(policy, times, scene, paths, broad, counts, overlap, virial):
             per unit length).
         counts: the counters (int64, changed in place). overlap: the deepest overlap seen so far.
         virial: the collision virial so far (``Tally.virial``).
+        laws: ``(gx, gy, falls, e, per_group, e_table, e_group, tc, last_collision, lost)``: gravity, the
+            discs it moves ``(N,)`` bool, the arguments of :func:`~discsim.engines.fixed_step.parts.restitution`
+            (``Shapes``' ``e``, ``per_group``, ``e_table`` ``(G, G)``, ``e_group`` ``(N,)`` int64, ``tc``, and
+            ``Paths.last_collision``, changed in place), and ``lost`` ``(1,)``: ``Tally.dissipated``, added to
+            in place.
 
     Returns:
         ``(ev_n, ev_f, frame_pos, list_pos, list_i, list_j, overlap, virial)``: the events, in order, as
@@ -642,7 +689,7 @@ def frames(policy, times, scene, paths, broad, counts, overlap, virial):
     for f in range(len(times)):
         here = (all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y)
         k, ev_n, ev_f, list_pos, list_i, list_j, overlap, virial = _frame(
-            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap, virial
+            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap, virial, laws
         )
         prev, pos = pos, prev
     return ev_n[:k], ev_f[:k], prev, list_pos, list_i, list_j, overlap, virial

@@ -59,6 +59,22 @@ def _scene_arrays(shapes: Shapes) -> tuple:
     )
 
 
+def _law_arrays(shapes: Shapes) -> tuple:
+    """The first eight slots of the ``laws`` argument of the compiled frames: gravity, the discs it moves, and
+    the restitution (the last two, ``Paths.last_collision`` and the energy lost, come with each call)."""
+    gx, gy = shapes.gravity
+    return (
+        float(gx),
+        float(gy),
+        np.ascontiguousarray(shapes.falls, dtype=np.bool_),
+        float(shapes.e),
+        bool(shapes.per_group),
+        np.array(shapes.e_table, dtype=np.float64).reshape(len(shapes.e_table), -1),
+        np.array(shapes.e_group, dtype=np.int64).reshape(-1),
+        float(shapes.tc),
+    )
+
+
 def _records(at: np.ndarray, ev_n: np.ndarray, states: np.ndarray) -> np.ndarray:
     """Log records of events at times ``at``: discs ``ev_n[:, 1:3]`` (j < 0: a wall or segment hit), the
     state after in ``states`` ``(E, 8)``."""
@@ -100,6 +116,8 @@ class CompiledFrame(Policy):
         scene, box = shapes.scene, shapes.box
         n = len(scene)
         self._scene = _scene_arrays(shapes)
+        self._laws = _law_arrays(shapes)
+        self._lost = np.zeros(1)
         self._verlet = broad if isinstance(broad, VerletGrid) else None  # the "grid" broad phase keeps the list
         if isinstance(broad, VerletGrid):
             # The numbers VerletGrid and neighbour_pairs compute, computed as they do.
@@ -136,11 +154,15 @@ class CompiledFrame(Policy):
         counts = self._counts
         counts[:] = 0
         state = (paths.ref_positions, paths.velocities, paths.ref_times, paths.images, paths.frame_positions)
+        lost = self._lost
+        lost[0] = tally.dissipated
+        laws = (*self._laws, paths.last_collision, lost)
         ev_n, ev_f, paths.frame_positions, list_pos, list_i, list_j, overlap, virial = kernels.frames(
-            self._code, times, self._scene, state, listed, counts, tally.max_overlap, tally.virial
+            self._code, times, self._scene, state, listed, counts, tally.max_overlap, tally.virial, laws
         )
         tally.max_overlap = overlap
         tally.virial = virial
+        tally.dissipated = float(lost[0])
         steps = counts.tolist()
         for name, step in zip(_COUNTERS, steps):
             tally.counts[name] += step
@@ -172,7 +194,8 @@ class CompiledSubFrame(Policy):
         # The float 2.0 comes from here, so that the compiled code cannot fold pow(x, 2.0) into x * x.
         self._sub = (moving, float(shapes.diameter), float(tol), 2.0, isinstance(broad, AllPairs))
         self._counts = np.zeros(5, dtype=np.int64)
-        self._acc = np.zeros(2)
+        self._acc = np.zeros(3)
+        self._laws = _law_arrays(shapes)[3:]  # the restitution (the sub-frame policies refuse gravity)
         self._jam = np.zeros(3, dtype=np.int64)
         self._swept = Swept(shapes, broad) if name == "swept" else None
         self._batch = max(1, BATCH_WORK // max(n, 1))
@@ -225,12 +248,13 @@ class CompiledSubFrame(Policy):
         """
         counts, acc = self._counts, self._acc
         counts[:] = 0
-        acc[0], acc[1] = tally.max_overlap, tally.virial
+        acc[0], acc[1], acc[2] = tally.max_overlap, tally.virial, tally.dissipated
         state = (paths.ref_positions, paths.velocities, paths.ref_times, paths.images, paths.frame_positions)
+        laws = (*self._laws, paths.last_collision)
         status, _, ev_n, ev_f, paths.frame_positions, jam_time = sub_frame.sub_frames(
-            self._code, times, float(t0), self._scene, self._sub, state, counts, acc, self._jam
+            self._code, times, float(t0), self._scene, self._sub, state, counts, acc, self._jam, laws
         )
-        tally.max_overlap, tally.virial = float(acc[0]), float(acc[1])
+        tally.max_overlap, tally.virial, tally.dissipated = float(acc[0]), float(acc[1]), float(acc[2])
         for name, step in zip(_SUB_COUNTERS, counts.tolist()):
             tally.counts[name] += step
         at = ev_f[:, 0]

@@ -75,8 +75,11 @@ from discsim.engines.fixed_step.numba.kernels import (
     _image,
     _image_step,
     _impulse_virial,
+    _kinetic_loss,
     _nearest_image,
     _reflect,
+    _reflect_wall,
+    _restitution,
     _wrap,
     cpython_hypot,
     jit,
@@ -133,12 +136,14 @@ def _at(paths, a, s):
 
 
 @leaf
-def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, counts, acc):
+def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, counts, acc, laws):
     """Answer the candidate: ``SubFrame._collide``, ``_wall`` or ``_segment``. Returns whether it did.
 
-    ``acc``: the deepest overlap and the collision virial (changed in place).
+    ``acc``: the deepest overlap, the collision virial and the energy dissipated (changed in place);
+    ``laws``: the restitution, as for :func:`sub_frames`.
     """
     radii, masses, periodic, width, height, segments, _, _, _ = scene
+    e0, per_group, table, group, tc_model, last = laws
     vel = paths[1]
     ev_n, ev_f = ev
     nan = math.nan
@@ -156,7 +161,15 @@ def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, count
         if depth > acc[0]:
             acc[0] = depth
         ma, mb = masses[a], masses[b]
-        uxa, uya, uxb, uyb = _collide(dx, dy, vxa, vya, vxb, vyb, ma, mb)
+        e = _restitution(a, b, tc, e0, per_group, table, group, tc_model, last)
+        uxa, uya, uxb, uyb = _collide(dx, dy, vxa, vya, vxb, vyb, ma, mb, e)
+        if e != 1.0:
+            acc[2] += _kinetic_loss(ma, vxa, vya, uxa, uya) + _kinetic_loss(mb, vxb, vyb, uxb, uyb)
+        if tc_model > 0.0:  # the TC model's clocks (an obstacle keeps none)
+            if moving[a]:
+                last[a] = tc
+            if moving[b]:
+                last[b] = tc
         acc[1] += _impulse_virial(dx, dy, vxa, vya, uxa, uya, vxb, vyb, uxb, uyb, ma, mb)
         if moving[a]:
             xa, ya = _turn(a, tc, xa, ya, uxa, uya, paths, version, periodic, width, height)
@@ -166,22 +179,25 @@ def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, count
         _log(ev_n, ev_f, st, frame, tc, a, b, xa, ya, uxa, uya, xb, yb, uxb, uyb)
         return True
     x, y = _at(paths, a, tc)
-    vx, vy = vel[a, 0], vel[a, 1]
+    wx, wy = vel[a, 0], vel[a, 1]
     if kind == WALL:
         axis, high = b // 2, b % 2
-        v = vx if axis == 0 else vy
+        v = wx if axis == 0 else wy
         if (v <= 0.0) if high else (v >= 0.0):  # moving away from this wall already
             return False
-        if axis == 0:
-            vx = -vx
-        else:
-            vy = -vy
+        e = _restitution(a, a, tc, e0, per_group, table, group, tc_model, last)
+        vx, vy = _reflect_wall(wx, wy, axis, e)
     else:
         ax, ay, bx, by = segments[b, 0], segments[b, 1], segments[b, 2], segments[b, 3]
         qx, qy = _closest_point(x, y, ax, ay, bx, by)
-        if vx * (x - qx) + vy * (y - qy) >= 0.0:  # receding
+        if wx * (x - qx) + wy * (y - qy) >= 0.0:  # receding
             return False
-        vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by)
+        e = _restitution(a, a, tc, e0, per_group, table, group, tc_model, last)
+        vx, vy = _reflect(x, y, wx, wy, ax, ay, bx, by, e)
+    if e != 1.0:
+        acc[2] += _kinetic_loss(masses[a], wx, wy, vx, vy)
+    if tc_model > 0.0:
+        last[a] = tc
     x, y = _turn(a, tc, x, y, vx, vy, paths, version, periodic, width, height)
     counts[C_WALL_HITS] += 1
     _log(ev_n, ev_f, st, frame, tc, a, -1, x, y, vx, vy, nan, nan, nan, nan)
@@ -265,7 +281,7 @@ def _recheck(code, a, now, t, kind, other, near, count, p, tol, paths, scene, tw
 
 # --- the frames ------------------------------------------------------------------------------------------------
 @jit
-def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam):
+def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam, laws):
     """Frames at ``times`` one after the other, each answering its contacts at their times.
 
     Changes the paths in place as ``SubFramePolicy.frame`` changes
@@ -279,8 +295,12 @@ def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam):
             diameter (``Shapes.diameter``), ``bisect_tol``, the float 2.0 (see the module's docstring) and
             whether the broad phase is ``"all-pairs"``.
         paths: ``(ref_pos, vel, ref_t, images, frame_pos)``, as in ``Paths``.
-        counts: the counters (int64, changed in place). acc: ``[deepest overlap, collision virial]``
-            (changed in place). jam: ``[a, b, kind]`` of the contact that jammed a frame (written then).
+        counts: the counters (int64, changed in place). acc: ``[deepest overlap, collision virial, energy
+            dissipated]`` (changed in place). jam: ``[a, b, kind]`` of the contact that jammed a frame
+            (written then).
+        laws: ``(e, per_group, e_table, e_group, tc, last_collision)``: the arguments of
+            :func:`~discsim.engines.fixed_step.parts.restitution` (``last_collision`` changed in place; no
+            gravity: the sub-frame policies refuse it).
 
     Returns:
         ``(status, frames, ev_n, ev_f, frame_pos, jam_time)``: :data:`DONE`, or :data:`JAMMED` when a
@@ -364,7 +384,7 @@ def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam):
                 jam[0], jam[1], jam[2] = a, b, kind
                 return JAMMED, f, ev_n[: st[S_EVENTS]], ev_f[: st[S_EVENTS]], prev, tc
             ev_n, ev_f = _room_i2(ev_n, st[S_EVENTS] + 1), _room_f2(ev_f, st[S_EVENTS] + 1)
-            if not _respond(kind, tc, a, b, f, moved, scene, moving, version, (ev_n, ev_f), st, counts, acc):
+            if not _respond(kind, tc, a, b, f, moved, scene, moving, version, (ev_n, ev_f), st, counts, acc, laws):
                 continue
             for q in range(2):  # the discs that changed course test their new paths
                 disc, partner = (a, b) if q == 0 else (b, a)

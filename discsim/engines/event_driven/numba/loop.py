@@ -40,6 +40,7 @@ from discsim.laws import BETA, GX, GY, PER_GROUP, REST_SPEED, TC, E
 from discsim.physics.compiled import (
     advance,
     closest_point_on_segment,
+    collide,
     cross,
     pair_predict,
     pair_resolve,
@@ -505,7 +506,8 @@ def run_events(
                     bounce = -e * ((vxi - vxj) * -dx + (vyi - vyj) * -dy)
                     up = gx * dx + gy * dy
                 norm = math.sqrt(dx * dx + dy * dy)
-                if up > 0.0 and bounce < law[REST_SPEED] * norm:
+                slow = bounce < law[REST_SPEED] * norm
+                if slow and up > 0.0:  # landed on it: the faller rests
                     if not i_falls:
                         uxi, uyi, uxj, uyj = vxi, vyi, 0.0, 0.0
                         rest[j] = 1
@@ -513,6 +515,14 @@ def run_events(
                         uxi, uyi, uxj, uyj = 0.0, 0.0, vxj, vyj
                         rest[i] = 1
                     ints[I_RESTS] += 1
+                elif slow:  # a slow touch from the side or below: the support holds, as an obstacle would (waking
+                    # it for so little would set a pile resting and waking at one instant for ever)
+                    if not i_falls:
+                        uxi, uyi = vxi, vyi
+                        _, _, uxj, uyj = collide(dx, dy, vxi, vyi, vxj, vyj, INF, mj, e)
+                    else:
+                        uxi, uyi, _, _ = collide(dx, dy, vxi, vyi, vxj, vyj, mi, INF, e)
+                        uxj, uyj = vxj, vyj
                 else:  # hit hard enough: a support at rest wakes (an obstacle stays)
                     rest[i] = 0
                     if moved_j:

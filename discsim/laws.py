@@ -101,6 +101,8 @@ class Laws:
                 raise InvalidArgumentError(msg)
             g = (float(pair[0]), float(pair[1]))
         pairs: tuple = ()
+        if isinstance(restitution, dict) and not restitution:
+            restitution = 1.0  # no pair named: every pair elastic
         if isinstance(restitution, dict):
             checked = {}
             for key, value in restitution.items():

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim.errors import TimeError
-from discsim.events import added_discs
+from discsim.events import EventKind, added_discs
 from discsim.model import image_steps
 from discsim.physics.dynamics import advance
 
@@ -78,8 +78,9 @@ def reconstruct(
             :attr:`LastRecords.images`), default none.
         gravity: the run's ``(gx, gy)`` (None: free flight). Between records a disc of finite mass (``masses``
             ``(N,)``, default all finite) falls, except after a record that left it at rest: a record of an
-            event with velocity exactly zero (the initial state always falls). A disc that an event stops dead
-            while it still falls (possible only in contrived, exactly symmetric collisions) is taken at rest.
+            event with velocity exactly zero (the initial state and an edit always fall). A disc that an event
+            stops dead while it still falls (possible only in contrived, exactly symmetric collisions) is taken at
+            rest.
 
     Returns:
         ``(T, N, 2)`` positions. An event exactly at a requested time counts as
@@ -89,9 +90,10 @@ def reconstruct(
     """
     times = np.atleast_1d(np.asarray(times, dtype=float))
     n = len(positions0)
-    disc, t_rec, state, starts = _sorted_records(events, positions0, velocities0, time0)
+    falling = gravity is not None and tuple(gravity) != (0.0, 0.0)
+    disc, t_rec, state, starts, *kind = _sorted_records(events, positions0, velocities0, time0, kinds=falling)
     periodic = box is not None and box.periodic
-    falls = _falling(disc, state, starts, gravity, masses)
+    falls = _falling(disc, state, kind[0], gravity, masses) if falling else None
     if unwrapped and periodic and (len(state) > n or images0 is not None):
         state[:, :2] += _image_counts(disc, t_rec, state, starts, box.size, images0, gravity, falls) * box.size
     out = np.empty((len(times), n, 2))
@@ -107,12 +109,12 @@ def reconstruct(
     return out
 
 
-def _falling(disc, state, starts, gravity, masses) -> np.ndarray | None:
-    """``(R,)`` bool: the records after which the disc falls (None without gravity; see :func:`reconstruct`)."""
-    if gravity is None or tuple(gravity) == (0.0, 0.0):
-        return None
-    moving = (state[:, 2] != 0.0) | (state[:, 3] != 0.0)
-    moving[starts[:-1]] = True  # the initial state falls
+def _falling(disc, state, kind, gravity, masses) -> np.ndarray:
+    """``(R,)`` bool: the records after which the disc falls (see :func:`reconstruct`): all but those of a
+    collision or wall hit that left the disc with velocity exactly zero (at rest), and the discs of infinite mass."""
+    still = (state[:, 2] == 0.0) & (state[:, 3] == 0.0)
+    physical = (kind == int(EventKind.COLLISION)) | (kind == int(EventKind.WALL))
+    moving = ~(still & physical)
     if masses is not None:
         moving &= np.isfinite(np.asarray(masses, dtype=float))[disc]
     return moving
@@ -129,11 +131,12 @@ def _flight(state, dt, gravity, falls) -> tuple[np.ndarray, np.ndarray]:
     return x, y
 
 
-def _sorted_records(events, positions0, velocities0, time0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _sorted_records(events, positions0, velocities0, time0, kinds: bool = False) -> tuple:
     """Every state record of every disc, sorted by disc, then time, then log order.
 
     Returns ``(disc (R,), time (R,), state (R, 4), starts (N + 1,))``: disc ``d`` owns rows
-    ``starts[d]:starts[d + 1]``, the first of which is its state at ``time0``.
+    ``starts[d]:starts[d + 1]``, the first of which is its state at ``time0``. With ``kinds``, also each record's
+    event kind ``(R,)`` (-1 for the state at ``time0``).
     """
     n = len(positions0)
     # One state record per disc per change: initial state, then each event's i and j.
@@ -166,6 +169,10 @@ def _sorted_records(events, positions0, velocities0, time0) -> tuple[np.ndarray,
         order = np.lexsort((seq, t_rec, disc))  # by disc, then time, then log order
     disc, t_rec, state = disc[order], t_rec[order], state[order]
     starts = np.searchsorted(disc, np.arange(n + 1))
+    if kinds:
+        seq = seq[order]
+        kind = np.where(seq >= 0, events["kind"][np.maximum(seq, 0)] if len(events) else -1, -1)
+        return disc, t_rec, state, starts, kind
     return disc, t_rec, state, starts
 
 

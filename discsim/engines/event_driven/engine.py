@@ -8,6 +8,7 @@ state crossing that edge is an :class:`~discsim.engines.event_driven.state.Event
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -132,6 +133,8 @@ class EventDriven(Turning, RunStops, Engine):
         roughness: float = -1.0,
     ):
         laws = Laws.build(gravity, restitution, tc, rest_speed, roughness)
+        if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
+            laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
         self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend, laws)
         self._backend.start()
 
@@ -263,9 +266,10 @@ class EventDriven(Turning, RunStops, Engine):
         for name, value in old.counts().items():
             setattr(state, name, value)
         state.virial, state.max_overlap, state.max_queue = old.virial, old.max_overlap, old.max_queue
-        if not self.laws.default:  # what the laws keep: the energy lost, and which kept discs are at rest
+        if not self.laws.default:  # what the laws keep: the energy lost and the TC model's memory; every disc
+            # wakes (a removed disc may have held others up; those still held come to rest again at once)
             state.dissipated = old.dissipated
-            state.resting[: len(keep)] = old.resting()[keep]
+            state.last_collision[: len(keep)] = old.export().last_collision[keep]
         spins, angles = old.turning()  # the kept discs keep turning (added ones start with their own spins)
         state.spins[: len(keep)], state.angles[: len(keep)] = spins[keep], angles[keep]
         spin_log = getattr(old, "spin_log", None)

@@ -121,6 +121,7 @@ def test_an_inelastic_gas_poured_into_a_box_settles_to_rest(every_backend):
     d = sim.positions[:, None] - sim.positions[None]
     dist = np.hypot(d[..., 0], d[..., 1]) + np.eye(len(pos)) * 10
     assert dist.min() >= 1.8 * (1 - 1e-9)  # no overlap
+    assert _floating(sim) == []  # nothing at rest in mid-air
     sim._check()
 
 
@@ -285,3 +286,77 @@ def test_replays_of_free_flight_refuse_a_run_under_gravity():
         ds.frames(sim, [0.5])
     with pytest.raises(InvalidArgumentError, match="gravity"):
         ds.view(sim)
+
+
+# --- found by review: rest and wake ---------------------------------------------------------------------------
+def _stack():
+    """B at rest on A, A at rest on the floor."""
+    discs = ds.Discs([[5.0, 1.0], [5.0, 3.0]], [[0.0, 0.0], [0.0, 0.0]], radii=1.0)
+    sim = ds.EventDriven(discs, BOX, gravity=(0.0, -G), restitution=0.5)
+    sim.run(until=1.0)
+    assert sim.resting.all()
+    return sim
+
+
+def _floating(sim):
+    """The discs at rest that nothing holds up (gravity along -y): not on the floor, and on no disc below."""
+    p, r = sim.positions, sim.discs.radii
+    out = []
+    for i in np.flatnonzero(sim.resting):
+        d = np.hypot(*(p - p[i]).T)
+        below = (d <= (r + r[i]) * (1 + 1e-9)) & (p[:, 1] < p[i, 1]) & (np.arange(len(r)) != i)
+        if p[i, 1] - r[i] > 1e-9 and not below.any():
+            out.append(int(i))
+    return out
+
+
+@pytest.mark.parametrize("edit", ["move", "remove", "knock"])
+def test_discs_held_up_by_a_support_fall_when_it_goes(every_backend, edit):
+    sim = _stack()
+    if edit == "move":
+        sim.set_positions([0], [[2.0, 1.0]])
+    elif edit == "remove":
+        sim.remove_discs([0])
+    else:  # a hard hit from the side wakes A, and with it B
+        sim.add_discs(ds.Discs([[1.0, 1.3]], [[20.0, 0.0]], radii=1.0))
+    sim.run(until=4.0)
+    top = sim.positions[0 if edit == "remove" else 1]
+    assert top[1] < 3.0 - 1e-3, sim.positions  # B did not stay where it was, in mid-air
+    assert sim.resting.all() and _floating(sim) == []
+
+
+def test_a_disc_skimming_the_floor_comes_to_rest_and_its_energy_is_counted(every_backend):
+    # There is no sliding contact: a bounce slower than rest_speed ends in rest even at e = 1, fast along the
+    # floor or not (docs/laws.md), and the kinetic energy it had is counted in dissipated.
+    sim = ds.EventDriven(ball(2.0, 1.0 + 1e-4, 10.0, -0.05), ds.Box(40.0, 10.0), gravity=(0.0, -G))
+    e0 = sim.energy()
+    sim.run(until=3.0)
+    assert sim.resting.all()
+    assert sim.energy() + sim.dissipated == pytest.approx(e0, rel=1e-12)
+    assert sim.dissipated == pytest.approx(0.5 * (10.0**2 + 0.05**2 + 2 * G * 1e-4), rel=1e-6)
+
+
+def test_a_disc_given_zero_velocity_under_gravity_falls_in_its_trajectory(every_backend):
+    sim = ds.EventDriven(ball(5.0, 8.0, 1.0, 0.0), BOX, gravity=(0.0, -G))
+    sim.run(until=0.2)
+    sim.set_velocities([0], [[0.0, 0.0]])
+    sim.run(until=0.5)
+    assert sim.trajectory([0.5])[0, 0] == pytest.approx(sim.positions[0], rel=1e-12)
+    assert sim.positions[0, 1] < 8.0
+
+
+def test_the_tc_memory_and_the_rest_speed_survive_adding_discs(every_backend):
+    discs = ds.Discs([[2.0, 5.0], [5.0, 5.0]], [[1.0, 0.0], [0.0, 0.0]], radii=1.0)
+    sim = ds.EventDriven(discs, BOX, gravity=(0.0, -G), restitution=0.5, tc=0.5)
+    rest_speed = sim.laws.rest_speed
+    sim.run(until=1.01)
+    before = sim.state().last_collision.copy()
+    assert np.isfinite(before).sum() == 2
+    sim.add_discs(ds.Discs([[8.5, 8.5]], [[0.0, 0.0]], radii=0.01))
+    assert sim.state().last_collision[:2].tolist() == before.tolist()
+    assert sim.laws.rest_speed == rest_speed  # not the new smallest radius's
+
+
+def test_an_empty_restitution_table_is_elastic():
+    sim = ds.EventDriven(ball(5.0, 5.0, 1.0), BOX, restitution={})
+    assert sim.laws.restitution == 1.0

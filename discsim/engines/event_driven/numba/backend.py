@@ -209,6 +209,7 @@ class NumbaBackend(CompiledReads):
         ints[lp.I_RESTS] = state.rests
         self._rest = state.resting[order].astype(np.int8)
         self._tlast = state.last_collision[order].astype(np.float64)
+        self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
         self._rot = np.column_stack(
             [state.spins[order], discs.inertia[order], state.angles[order], np.full(n, float(state.time))]
@@ -358,7 +359,18 @@ class NumbaBackend(CompiledReads):
         else:
             x, y = float(position[0]), float(position[1])
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
+        held: list[int] = []
+        if self.laws.falls and self._rest[k] != 0:  # a support at rest moves: what it held up falls again
+            gx, gy = self.laws.gravity
+            grid = self.grid
+            count = lp.supported(
+                k, gx, gy, rec, self._rest, self._cell, self._head, self._nxt,
+                grid.nx, grid.ny, bool(self.box.periodic), self._edges, self._found,
+            )  # fmt: skip
+            held = self._found[:count].tolist()
         lp.set_disc(k, x, y, float(vx), float(vy), cell, t, *self._predict_args())
+        for d in held:
+            lp.set_disc(d, float(rec[d, 0]), float(rec[d, 1]), 0.0, 0.0, int(self._cell[d]), t, *self._predict_args())
 
     # --- argument lists of the compiled functions --------------------------------------------
     def _geometry(self) -> tuple:
@@ -382,7 +394,7 @@ class NumbaBackend(CompiledReads):
             self._rec, self._count, self._order, self._images, self._kept_partner, self._kept_stamp,
             self._cell, self._head, self._nxt,
             *self._geometry(), *self._filter(), *self._queue(), self._floats, self._etab, self._egroup, self._tlast,
-            self._rot,
+            self._found, self._rot,
         )  # fmt: skip
 
 

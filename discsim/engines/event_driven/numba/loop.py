@@ -291,6 +291,64 @@ def set_disc(
         ints[I_MAXQ] = ints[I_SIZE]
 
 
+@jit
+def supported(k, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, found):
+    """The discs at rest that ``k`` holds up, and those they hold up in turn: every disc at rest touching one of
+    them from above (against gravity ``(gx, gy)``), found through the cells around each. Each is marked awake
+    (``rest`` 0) as it is found, so none comes twice; their numbers go to ``found[:n]`` (an ``(N,)`` array);
+    returns ``n``.
+
+    Called when ``k`` stops being a support where it stood: woken by a hard hit, or edited. Without it the discs
+    resting on ``k`` would stay at rest in mid-air."""
+    width = edges[nx]
+    height = edges[nx + 1 + ny]
+    n = 0
+    done = -1  # found[done] is the support whose neighbours are scanned (-1: k itself)
+    while done < n:
+        b = k if done < 0 else found[done]
+        done += 1
+        xb, yb, rb = rec[b, X], rec[b, Y], rec[b, R]
+        c = cell[b]
+        cx = c // ny
+        cy = c - cx * ny
+        for ddx in range(-1, 2):
+            ox = cx + ddx
+            sx = 0.0
+            if periodic:
+                if ox < 0:
+                    ox += nx
+                    sx = -width
+                elif ox >= nx:
+                    ox -= nx
+                    sx = width
+            elif ox < 0 or ox >= nx:
+                continue
+            for ddy in range(-1, 2):
+                oy = cy + ddy
+                sy = 0.0
+                if periodic:
+                    if oy < 0:
+                        oy += ny
+                        sy = -height
+                    elif oy >= ny:
+                        oy -= ny
+                        sy = height
+                elif oy < 0 or oy >= ny:
+                    continue
+                j = head[ox * ny + oy]
+                while j >= 0:
+                    if rest[j] != 0 and rec[j, M] != INF and j != k:
+                        dx = rec[j, X] + sx - xb  # a disc at rest does not move: its record holds where it is
+                        dy = rec[j, Y] + sy - yb
+                        reach = (rb + rec[j, R]) * (1.0 + 1e-9)
+                        if dx * dx + dy * dy <= reach * reach and gx * dx + gy * dy < 0.0:
+                            rest[j] = 0
+                            found[n] = j
+                            n += 1
+                    j = nxt[j]
+    return n
+
+
 # --- cells ---------------------------------------------------------------------------------------------
 @jit
 def link(members, sizes, head, nxt):
@@ -397,7 +455,7 @@ def run_events(
     rec, count, order, images, kept_partner, kept_stamp, cell, head, nxt,
     nx, ny, periodic, edges,
     seg, seg_start, seg_idx, group, blocked, rest,
-    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats, etab, egroup, tlast, rot,
+    qt, bheap, bht, bpos, barg, qk, qo, qs, ints, floats, etab, egroup, tlast, found, rot,
     ev_t, ev_kind, ev_i, ev_j, ev_f, ev_w,
 ):  # fmt: skip
     """Process events with times <= ``until``: the Python backend's ``process_events``, compiled.
@@ -485,6 +543,7 @@ def run_events(
                 xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic, e
             )
             moved_j = mj != INF  # obstacles never move, and their counter never changes
+            woke = -1
             if LAWS and rough:  # the tangential impulse at the contact turns both (at right angles to the normal one)
                 turn(i, t + epoch, rot)
                 turn(j, t + epoch, rot)
@@ -523,7 +582,8 @@ def run_events(
                     else:
                         uxi, uyi, _, _ = collide(dx, dy, vxi, vyi, vxj, vyj, mi, INF, e)
                         uxj, uyj = vxj, vyj
-                else:  # hit hard enough: a support at rest wakes (an obstacle stays)
+                else:  # hit hard enough: a support at rest wakes (an obstacle stays), and what it held up
+                    woke = i if not i_falls else (j if moved_j else -1)
                     rest[i] = 0
                     if moved_j:
                         rest[j] = 0
@@ -573,6 +633,19 @@ def run_events(
                     seg, seg_start, seg_idx, group, blocked, rest,
                     qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
                 )  # fmt: skip
+                if ints[I_SIZE] > max_queue:
+                    max_queue = ints[I_SIZE]
+            if LAWS and woke >= 0:  # the discs at rest that the woken support held up fall again from here
+                for m in range(supported(woke, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, found)):
+                    d = found[m]
+                    rec[d, T] = t  # at rest: its record holds where it is, now
+                    count[d] += 1
+                    predict(
+                        d, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                        nx, ny, periodic, edges,
+                        seg, seg_start, seg_idx, group, blocked, rest,
+                        qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
+                    )  # fmt: skip
                 if ints[I_SIZE] > max_queue:
                     max_queue = ints[I_SIZE]
             last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j

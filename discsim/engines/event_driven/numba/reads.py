@@ -40,6 +40,7 @@ class CompiledReads:
     _barg: np.ndarray
     _group: np.ndarray
     _tlast: np.ndarray
+    _found: np.ndarray
     _egroup: np.ndarray
     _law_of_motion: Any
     laws: Any

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from discsim.errors import CheckpointError, DiscsimError
+from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import iter_stream, read_stream, stream_index
 from discsim.model import Box, Discs
@@ -37,7 +37,7 @@ DEFAULT_CHUNK = 65_536
 
 
 def stream_header(
-    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None
+    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None, gravity=None
 ) -> tuple[dict, dict]:
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
@@ -47,6 +47,8 @@ def stream_header(
         run_id: identifies the run, so that a resumed run appends only to its own log.
         base: physical events the run had processed before the log starts.
         ids: ``(N,)`` the discs' ids (``sim.ids``), stored only when given (None: their indices).
+        gravity: the run's ``(gx, gy)``, stored when given: a replay of the log (free flight between records)
+            then refuses to rebuild positions.
     """
     meta = {
         "kind": STREAM_KIND,
@@ -56,6 +58,8 @@ def stream_header(
         "n": len(discs),
         "box": box.as_dict(),
     }
+    if gravity is not None:
+        meta["gravity"] = [float(gravity[0]), float(gravity[1])]
     arrays = {
         "positions": discs.positions,
         "velocities": discs.velocities,
@@ -81,6 +85,7 @@ class StreamedEvents:
             time when it last wrote to the log).
         run_id: the run that wrote the log.
         ids: ``(N,)`` the ids of ``discs`` (the names the records give them), or None: their indices.
+        gravity: the run's ``(gx, gy)`` if it ran under gravity (then :meth:`trajectory` refuses), else None.
     """
 
     events: np.ndarray
@@ -90,6 +95,7 @@ class StreamedEvents:
     end_time: float
     run_id: str
     ids: np.ndarray | None = None
+    gravity: tuple | None = None
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -100,7 +106,9 @@ class StreamedEvents:
 
         Raises:
             TimeError: if a time is not finite or lies outside the logged span.
+            InvalidArgumentError: if the run was under gravity (its replay would be free flight's).
         """
+        refuse_gravity("the streamed log", {"gravity": self.gravity})
         return positions_from_log(
             self.events,
             self.discs,
@@ -152,7 +160,10 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
         msg = f"{path}: records of dtype {stream.records.dtype}, expected the event dtype"
         raise CheckpointError(msg)
     end_time = float(stream.last.get("time", start_time))
-    return StreamedEvents(stream.records, discs, box, start_time, end_time, run_id, ids)
+    gravity = stream.meta.get("gravity")
+    return StreamedEvents(
+        stream.records, discs, box, start_time, end_time, run_id, ids, None if gravity is None else tuple(gravity)
+    )
 
 
 def _header(path, meta, arrays) -> tuple[Discs, Box, float, str, np.ndarray | None]:
@@ -308,6 +319,22 @@ def iter_events(
     )
 
 
+def refuse_gravity(path, meta) -> None:
+    """Refuse to replay a log streamed under gravity: the replay is free flight's between records.
+
+    Raises:
+        InvalidArgumentError: naming the file and the gravity.
+    """
+    gravity = meta.get("gravity") if isinstance(meta, dict) else None
+    if gravity is not None:
+        msg = (
+            f"{path}: this event log was streamed under gravity {tuple(gravity)}, and its replay is free flight's "
+            "between records: rebuild positions with sim.trajectory(times) while the run holds its log, or sample "
+            "the run with ds.Sampler(dt)"
+        )
+        raise InvalidArgumentError(msg)
+
+
 def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndarray:
     """Exact positions ``(T, N, 2)`` at ``times`` ``(T,)`` from a streamed event log.
 
@@ -332,6 +359,7 @@ def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndar
     """
     if isinstance(source, StreamedEvents):
         return source.trajectory(times, unwrapped=unwrapped)
+    refuse_gravity(source, stream_index(Path(source))[0])
     log = iter_events(Path(source), unwrapped=unwrapped)
     times = check_times(times, log.start_time, log.end_time, "logged span")
     origin = LastRecords.at_start(log.discs, log.start_time, log.ids)

@@ -197,7 +197,9 @@ class EventStream(Observer):
         else:  # earlier events stay out of this file
             discs, ids, start, base = engine.snapshot(), context.ids, engine.time, logged
         run_id = context.ensure_run_id()
-        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids)
+        laws = getattr(engine, "laws", None)
+        gravity = laws.gravity if laws is not None and laws.falls else None
+        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids, gravity)
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
         self._created = True
         context.stream = {

@@ -360,3 +360,14 @@ def test_the_tc_memory_and_the_rest_speed_survive_adding_discs(every_backend):
 def test_an_empty_restitution_table_is_elastic():
     sim = ds.EventDriven(ball(5.0, 5.0, 1.0), BOX, restitution={})
     assert sim.laws.restitution == 1.0
+
+
+def test_a_log_streamed_under_gravity_refuses_a_free_flight_replay(tmp_path):
+    path = tmp_path / "events.dse"
+    sim = ds.EventDriven(ball(5.0, 8.0, 1.0), BOX, gravity=(0.0, -G), record=False).run(until=1.0, record_to=path)
+    log = ds.read_events(path)
+    assert len(log.events) == sim.counts["wall_hits"] and log.gravity == (0.0, -G)
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.trajectory_from_events(path, [0.5])
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        log.trajectory([0.5])

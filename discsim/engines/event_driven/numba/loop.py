@@ -35,8 +35,28 @@ import numpy as np
 from discsim._compiled import inline, jit, prefetch
 from discsim.engines.event_driven.numba import blocks
 from discsim.engines.event_driven.numba.blocks import BLOCK, BLOCK_SHIFT, discard, push, reblock  # noqa: F401
+from discsim.engines.event_driven.numba.cells import _enter, _leave, link, unlink  # noqa: F401
+from discsim.engines.event_driven.numba.support import (  # noqa: F401
+    ANGLE,
+    ANGLE_T,
+    INERTIA,
+    KEPT,
+    VX,
+    VY,
+    M,
+    R,
+    T,
+    W,
+    X,
+    Y,
+    accel,
+    restitution,
+    spin_energy,
+    supported,
+    turn,
+)
 from discsim.events import EventKind
-from discsim.laws import BETA, GX, GY, PER_GROUP, REST_SPEED, TC, E
+from discsim.laws import BETA, GX, GY, REST_SPEED, TC
 from discsim.physics.compiled import (
     advance,
     closest_point_on_segment,
@@ -57,10 +77,6 @@ INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT = (
     int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT)
 )
-# Columns of a disc's row in ``rec``.
-X, Y, VX, VY, T, R, M, KEPT = 0, 1, 2, 3, 4, 5, 6, 7
-# Columns of a disc's row in ``rot``: spin, moment of inertia, angle at the absolute time ``ANGLE_T``.
-W, INERTIA, ANGLE, ANGLE_T = 0, 1, 2, 3
 # Slots of ``ints``.
 I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS = range(12)
 N_INTS = 12
@@ -80,14 +96,6 @@ DONE, MORE, CROSSINGS = 0, 1, 2
 
 
 # --- prediction ----------------------------------------------------------------------------------------
-@inline
-def accel(k, gravity, gx, gy, rec, rest):
-    """Disc ``k``'s acceleration: gravity, unless there is none, ``k`` is an obstacle or it is at rest."""
-    if gravity and rec[k, M] != INF and rest[k] == 0:
-        return gx, gy
-    return 0.0, 0.0
-
-
 @inline
 def predict(
     i, t, exclude, direction,
@@ -214,32 +222,6 @@ def predict(
         push(i, t_best, kind, other, 0, qt, bheap, bht, bpos, barg, qk, qo, qs, ints)
 
 
-@inline
-def restitution(i, j, now, law, etab, egroup, tlast):
-    """The coefficient of restitution of a collision of ``i`` and ``j`` (``i`` twice: a wall) at time ``now``:
-    one number or the pair of groups' (:class:`~discsim.laws.Laws`), 1 within the TC time of either's last."""
-    e = law[E]
-    if law[PER_GROUP] != 0.0:
-        e = etab[egroup[i], egroup[j]]
-    tc = law[TC]
-    if tc > 0.0 and (now - tlast[i] < tc or now - tlast[j] < tc):
-        e = 1.0
-    return e
-
-
-@inline
-def turn(k, now, rot):
-    """Bring disc ``k``'s angle to the absolute time ``now`` (its spin has been constant since its angle's time)."""
-    rot[k, ANGLE] += rot[k, W] * (now - rot[k, ANGLE_T])
-    rot[k, ANGLE_T] = now
-
-
-@inline
-def spin_energy(inertia, w):
-    """``I w^2 / 2``; 0 for a disc that cannot turn (``I`` inf: its spin never changes)."""
-    return 0.0 if inertia == INF else 0.5 * inertia * w * w
-
-
 @jit
 def predict_all(
     rec, count, kept_partner, kept_stamp, cell, head, nxt,
@@ -289,124 +271,6 @@ def set_disc(
     )  # fmt: skip
     if ints[I_SIZE] > ints[I_MAXQ]:
         ints[I_MAXQ] = ints[I_SIZE]
-
-
-@jit
-def supported(k, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, found):
-    """The discs at rest that ``k`` holds up, and those they hold up in turn: every disc at rest touching one of
-    them from above (against gravity ``(gx, gy)``), found through the cells around each. Each is marked awake
-    (``rest`` 0) as it is found, so none comes twice; their numbers go to ``found[:n]`` (an ``(N,)`` array);
-    returns ``n``.
-
-    Called when ``k`` stops being a support where it stood: woken by a hard hit, or edited. Without it the discs
-    resting on ``k`` would stay at rest in mid-air."""
-    width = edges[nx]
-    height = edges[nx + 1 + ny]
-    n = 0
-    done = -1  # found[done] is the support whose neighbours are scanned (-1: k itself)
-    while done < n:
-        b = k if done < 0 else found[done]
-        done += 1
-        xb, yb, rb = rec[b, X], rec[b, Y], rec[b, R]
-        c = cell[b]
-        cx = c // ny
-        cy = c - cx * ny
-        for ddx in range(-1, 2):
-            ox = cx + ddx
-            sx = 0.0
-            if periodic:
-                if ox < 0:
-                    ox += nx
-                    sx = -width
-                elif ox >= nx:
-                    ox -= nx
-                    sx = width
-            elif ox < 0 or ox >= nx:
-                continue
-            for ddy in range(-1, 2):
-                oy = cy + ddy
-                sy = 0.0
-                if periodic:
-                    if oy < 0:
-                        oy += ny
-                        sy = -height
-                    elif oy >= ny:
-                        oy -= ny
-                        sy = height
-                elif oy < 0 or oy >= ny:
-                    continue
-                j = head[ox * ny + oy]
-                while j >= 0:
-                    if rest[j] != 0 and rec[j, M] != INF and j != k:
-                        dx = rec[j, X] + sx - xb  # a disc at rest does not move: its record holds where it is
-                        dy = rec[j, Y] + sy - yb
-                        reach = (rb + rec[j, R]) * (1.0 + 1e-9)
-                        if dx * dx + dy * dy <= reach * reach and gx * dx + gy * dy < 0.0:
-                            rest[j] = 0
-                            found[n] = j
-                            n += 1
-                    j = nxt[j]
-    return n
-
-
-# --- cells ---------------------------------------------------------------------------------------------
-@jit
-def link(members, sizes, head, nxt):
-    """Build the cells' linked lists from ``members`` (internal numbers, cell by cell) and ``sizes``."""
-    k = 0
-    for c in range(sizes.shape[0]):
-        previous = -1
-        head[c] = -1
-        for _ in range(sizes[c]):
-            j = members[k]
-            k += 1
-            nxt[j] = -1
-            if previous < 0:
-                head[c] = j
-            else:
-                nxt[previous] = j
-            previous = j
-
-
-@jit
-def unlink(head, nxt, members, sizes):
-    """The cells' members in order (internal numbers), cell by cell, and each cell's size."""
-    k = 0
-    for c in range(head.shape[0]):
-        j = head[c]
-        n = 0
-        while j >= 0:
-            members[k] = j
-            k += 1
-            n += 1
-            j = nxt[j]
-        sizes[c] = n
-
-
-# Cells are singly linked lists in the order their discs entered (as the Python backend's tuples): a cell
-# holds a disc or two, so walking it to leave or to join costs less than a second link per disc and a tail
-# per cell would in memory.
-@jit
-def _leave(i, c, head, nxt):
-    j = head[c]
-    if j == i:
-        head[c] = nxt[i]
-        return
-    while nxt[j] != i:
-        j = nxt[j]
-    nxt[j] = nxt[i]
-
-
-@jit
-def _enter(i, c, head, nxt):
-    nxt[i] = -1
-    j = head[c]
-    if j < 0:
-        head[c] = i
-        return
-    while nxt[j] >= 0:
-        j = nxt[j]
-    nxt[j] = i
 
 
 @inline

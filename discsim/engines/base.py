@@ -462,5 +462,22 @@ class Engine(DiscEditing, EventRecord, SpatialQueries, ABC):
         """Total momentum ``(2,)`` of the discs of finite mass."""
         return momentum(self.velocities, self.discs.masses)
 
+    def potential_energy(self) -> float:
+        """The potential energy in the gravity field of a run under gravity (``laws``), ``-sum(m g . r)`` over the
+        discs of finite mass, zero at the box's origin; 0 without gravity. ``r`` is the unwrapped centre in a
+        periodic box (a disc that falls through the floor and comes in at the top keeps falling: its energy stays
+        its own). Units: mass length^2 / time^2."""
+        laws = getattr(self, "laws", None)
+        if laws is None or not laws.falls:
+            return 0.0
+        masses = self.discs.masses
+        finite = np.isfinite(masses)
+        return float(-np.sum(masses[finite] * (self.unwrapped_positions[finite] @ np.array(laws.gravity))))
+
+    def energy(self) -> float:
+        """Kinetic plus potential energy. Exact runs keep it when collisions are elastic and no disc comes to rest
+        (``energy() + dissipated`` always); a fixed-step run changes it by the stepping's error."""
+        return self.kinetic_energy() + self.potential_energy()
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n={len(self.discs)}, time={self.time:g}, box={self.box})"

@@ -374,23 +374,6 @@ class EventDriven(Turning, RunStops, Engine):
         """``(N,)`` bool: the discs at rest now (under gravity: velocity zero, gravity off; a fresh copy)."""
         return self._backend.resting()
 
-    def potential_energy(self) -> float:
-        """The potential energy in the gravity field, ``-sum(m g . r)`` over the discs of finite mass (zero at the
-        origin of the box; 0 without gravity). In a periodic box ``r`` is the unwrapped centre (a disc that falls
-        through the floor and comes in at the top keeps falling: its energy stays its own). Units: mass
-        length^2 / time^2."""
-        if not self.laws.falls:
-            return 0.0
-        masses = self.discs.masses
-        finite = np.isfinite(masses)
-        g = np.array(self.laws.gravity)
-        return float(-np.sum(masses[finite] * (self._backend.unwrapped_positions()[finite] @ g)))
-
-    def energy(self) -> float:
-        """Kinetic plus potential energy: conserved exactly when collisions are elastic (``restitution=1``)
-        and no disc comes to rest; it falls by :attr:`dissipated` otherwise."""
-        return self.kinetic_energy() + self.potential_energy()
-
     def pressure(self) -> float:
         """Pressure from the collision virial, averaged since the start.
 

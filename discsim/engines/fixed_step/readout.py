@@ -101,22 +101,6 @@ class FrameReadout:
         """
         return self._tally.dissipated
 
-    def potential_energy(self) -> float:
-        """The potential energy in the gravity field, ``-sum(m g . r)`` over the discs of finite mass (zero at the
-        origin of the box; 0 without gravity). ``r`` is the unwrapped centre in a periodic box. Units: mass
-        length^2 / time^2."""
-        if not self.laws.falls:
-            return 0.0
-        masses = self.discs.masses
-        finite = np.isfinite(masses)
-        g = np.array(self.laws.gravity)
-        return float(-np.sum(masses[finite] * (self.unwrapped_positions[finite] @ g)))
-
-    def energy(self) -> float:
-        """Kinetic plus potential energy. An exact run would keep it with ``restitution=1``; a fixed-step run
-        changes it by the stepping's error (see :attr:`dissipated`)."""
-        return self.kinetic_energy() + self.potential_energy()
-
     def pressure(self) -> float:
         """Pressure from the virial of the impulses the frames applied, averaged since the start.
 

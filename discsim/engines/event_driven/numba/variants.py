@@ -45,7 +45,6 @@ def with_physics(law_of_motion=None, collision_law=None, *, interpreted: bool = 
         ``run_events``; :class:`~discsim.engines.event_driven.numba.backend.NumbaBackend` runs it as it runs
         this module.
     """
-    from types import FunctionType
 
     from discsim._numba import numba
     from discsim.physics.compiled import compile_parts
@@ -59,18 +58,7 @@ def with_physics(law_of_motion=None, collision_law=None, *, interpreted: bool = 
     namespace.update(compile_parts(law_of_motion, collision_law, interpreted=interpreted))
     if interpreted:
         namespace.update(_prefetch_disc=_no_prefetch, _prefetch_cells=_no_prefetch)
-    for name in loop.PHYSICAL:
-        dispatcher = vars(loop)[name]
-        source = getattr(dispatcher, "py_func", dispatcher)
-        table = dict(source.__globals__)
-        table.update({key: namespace[key] for key in table if key in namespace})
-        rebuilt = FunctionType(source.__code__, table, source.__name__, source.__defaults__)
-        rebuilt.__qualname__ = source.__qualname__
-        if interpreted:
-            namespace[name] = rebuilt
-        else:
-            options = {key: value for key, value in dispatcher.targetoptions.items() if key != "nopython"}
-            namespace[name] = nb.njit(cache=False, **options)(rebuilt)
+    _rebuild(namespace, interpreted, suffix="", cache=False)
     _BUILT[key] = (law_of_motion, collision_law, namespace)
     return namespace
 
@@ -93,7 +81,6 @@ def with_laws(*, interpreted: bool = False) -> dict:
     Returns:
         This module's namespace (a dict) with the loop's functions replaced.
     """
-    from types import FunctionType
 
     from discsim._numba import numba
 
@@ -105,22 +92,32 @@ def with_laws(*, interpreted: bool = False) -> dict:
     namespace["LAWS"] = True
     if interpreted:
         namespace.update(_prefetch_disc=_no_prefetch, _prefetch_cells=_no_prefetch)
+    _rebuild(namespace, interpreted, suffix="_laws", cache=True)  # its own names: its own cache files
+    _LAWS_BUILT[interpreted] = namespace
+    return namespace
+
+
+def _rebuild(namespace: dict, interpreted: bool, *, suffix: str, cache: bool) -> None:
+    """Rebuild the loop's :data:`~discsim.engines.event_driven.numba.loop.PHYSICAL` functions from their very
+    source over ``namespace`` (each calling the others' rebuilt versions), named with ``suffix``, and put them
+    in it: compiled (``cache``: on disk, under those names) or, ``interpreted``, as plain functions."""
+    from types import FunctionType
+
+    from discsim._numba import numba
+
     for name in loop.PHYSICAL:
         dispatcher = vars(loop)[name]
         source = getattr(dispatcher, "py_func", dispatcher)
         table = dict(source.__globals__)
         table.update({key: namespace[key] for key in table if key in namespace})
-        table["LAWS"] = True
-        rebuilt = FunctionType(source.__code__, table, f"{source.__name__}_laws", source.__defaults__)
-        rebuilt.__qualname__ = f"{source.__qualname__}_laws"
+        rebuilt = FunctionType(source.__code__, table, f"{source.__name__}{suffix}", source.__defaults__)
+        rebuilt.__qualname__ = f"{source.__qualname__}{suffix}"
         rebuilt.__module__ = source.__module__
         if interpreted:
             namespace[name] = rebuilt
         else:
             options = {key: value for key, value in dispatcher.targetoptions.items() if key != "nopython"}
-            namespace[name] = nb.njit(cache=True, **options)(rebuilt)  # its own cache files, by its own name
-    _LAWS_BUILT[interpreted] = namespace
-    return namespace
+            namespace[name] = numba().njit(cache=cache, **options)(rebuilt)
 
 
 def _no_prefetch(*args) -> None:

@@ -89,7 +89,8 @@ def test_a_ball_dropped_on_a_segments_end_point(every_backend):
     assert event.time == pytest.approx(math.sqrt(2 * drop / G), rel=1e-9)
 
 
-@pytest.mark.parametrize("periodic", [False, True])
+# Periodic: the gas falls for ever, ever faster (9 s a case): slow.
+@pytest.mark.parametrize("periodic", [False, pytest.param(True, marks=pytest.mark.slow)])
 @pytest.mark.parametrize("gravity", [(0.0, -G), (G, 0.0), (3.0, -4.0)])
 def test_elastic_gas_under_gravity_conserves_energy_and_both_backends_agree(every_backend, gravity, periodic):
     discs, box = ds.random_gas(40, 0.3, seed=4, periodic=periodic)

@@ -1,9 +1,9 @@
 """The laws a run uses, as the user chose them: gravity, restitution (with the TC model), rest and roughness,
 validated once.
 
-:class:`Laws` is what every engine takes from its ``gravity=``, ``restitution=``, ``tc=``, ``rest_speed=`` and
-``roughness=`` keywords: it checks them (a :class:`~discsim.errors.DiscsimError` naming the argument and its
-value, before anything changes), stores them in a run's settings and checkpoints, and gives the compiled loops
+:class:`Laws` is what every engine takes from its ``gravity=``, ``restitution=``, ``tc=``, ``rest_speed=``,
+``roughness=`` and ``drag=`` keywords: it checks them (a :class:`~discsim.errors.DiscsimError` naming the argument
+and its value, before anything changes), stores them in a run's settings and checkpoints, and gives the compiled loops
 their numbers as one small float array (:meth:`Laws.array`) and one table (:meth:`Laws.table`). The defaults are
 today's physics, free flight and elastic, smooth collisions, bit for bit (:attr:`Laws.default`).
 
@@ -28,9 +28,9 @@ __all__ = ["LAW_SLOTS", "Laws"]
 
 #: Slots of :meth:`Laws.array`: gravity along x and y, the rest speed, the TC time, whether the restitution
 #: depends on the pair of groups (1.0) or is one number (0.0), that number, and the roughness (tangential
-#: restitution) beta.
-GX, GY, REST_SPEED, TC, PER_GROUP, E, BETA = range(7)
-LAW_SLOTS = 7
+#: restitution) beta, and the drag gamma.
+GX, GY, REST_SPEED, TC, PER_GROUP, E, BETA, DRAG = range(8)
+LAW_SLOTS = 8
 #: The default rest speed, as a bounce height: a disc that would bounce less high than this fraction of the
 #: smallest radius comes to rest (see :class:`Laws`).
 REST_HEIGHT = 1e-3
@@ -71,6 +71,9 @@ class Laws:
             -1, smooth (frictionless: spins never change, today's physics bit for bit); +1, perfectly rough
             (the tangential relative velocity of the contact points reverses, energy conserved); between, the
             tangential relative velocity is scaled by ``-beta`` (:func:`discsim.physics.laws.rough_impulse`).
+        drag: the linear drag ``gamma`` >= 0 of every disc of finite mass (1 / time): a force ``-m gamma v``, so
+            that between events a velocity relaxes as ``e^(-gamma t)`` towards the terminal velocity
+            ``g / gamma`` (:mod:`discsim.physics.damped`); 0: none.
     """
 
     gravity: tuple[float, float] = (0.0, 0.0)
@@ -78,16 +81,17 @@ class Laws:
     tc: float = 0.0
     rest_speed: float | None = None
     roughness: float = -1.0
+    drag: float = 0.0
     _pairs: tuple = field(default=(), repr=False)
 
     @classmethod
-    def build(cls, gravity=None, restitution=1.0, tc=0.0, rest_speed=None, roughness=-1.0) -> Laws:
+    def build(cls, gravity=None, restitution=1.0, tc=0.0, rest_speed=None, roughness=-1.0, drag=0.0) -> Laws:
         """Check the keywords as the engines take them and build the laws.
 
         Raises:
             InvalidArgumentError: naming the argument and value: gravity not a pair of finite numbers, a
                 restitution outside [0, 1] (or a malformed dict), a negative or non-finite ``tc`` or
-                ``rest_speed``, a roughness outside [-1, 1].
+                ``rest_speed``, a roughness outside [-1, 1], a negative or non-finite drag.
         """
         if gravity is None:
             g = (0.0, 0.0)
@@ -132,12 +136,17 @@ class Laws:
         if not -1.0 <= beta <= 1.0:
             msg = f"roughness must lie in [-1, 1] (-1: smooth, +1: perfectly rough), got {roughness!r}"
             raise InvalidArgumentError(msg)
-        return cls(g, e, tc, rest_speed, beta, pairs)
+        gamma = _number("drag", drag)
+        if not (math.isfinite(gamma) and gamma >= 0.0):
+            msg = f"drag must be a finite number >= 0 (1 / time), got {drag!r}"
+            raise InvalidArgumentError(msg)
+        return cls(g, e, tc, rest_speed, beta, gamma, pairs)
 
     @property
     def default(self) -> bool:
         """True for free flight and elastic collisions: today's physics, bit for bit."""
-        return self.gravity == (0.0, 0.0) and not self._pairs and self.restitution == 1.0 and not self.rough
+        plain = self.gravity == (0.0, 0.0) and not self._pairs and self.restitution == 1.0
+        return plain and not self.rough and self.drag == 0.0
 
     @property
     def rough(self) -> bool:
@@ -153,7 +162,11 @@ class Laws:
         """The laws as a run's settings store them (plain JSON: pairs of groups as ``"a,b"`` keys)."""
         e = {f"{a},{b}": v for (a, b), v in self._pairs} if self._pairs else self.restitution
         out = {"gravity": list(self.gravity), "restitution": e, "tc": self.tc, "rest_speed": self.rest_speed}
-        return {**out, "roughness": self.roughness} if self.rough else out
+        if self.rough:
+            out["roughness"] = self.roughness
+        if self.drag != 0.0:
+            out["drag"] = self.drag
+        return out
 
     @classmethod
     def from_settings(cls, settings: dict) -> Laws:
@@ -163,7 +176,12 @@ class Laws:
             e = {tuple(int(v) for v in key.split(",")): value for key, value in e.items()}
         gravity = settings.get("gravity")
         return cls.build(
-            gravity, e, settings.get("tc", 0.0), settings.get("rest_speed"), settings.get("roughness", -1.0)
+            gravity,
+            e,
+            settings.get("tc", 0.0),
+            settings.get("rest_speed"),
+            settings.get("roughness", -1.0),
+            settings.get("drag", 0.0),
         )
 
     def rest_speed_for(self, radii: np.ndarray) -> float:
@@ -184,6 +202,7 @@ class Laws:
         out[PER_GROUP] = 1.0 if self._pairs else 0.0
         out[E] = 1.0 if self._pairs else float(self.restitution)  # type: ignore[arg-type]
         out[BETA] = self.roughness
+        out[DRAG] = self.drag
         return out
 
     def table(self, labels: np.ndarray) -> np.ndarray:

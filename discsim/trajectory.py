@@ -14,7 +14,7 @@ import numpy as np
 from discsim.errors import TimeError
 from discsim.events import EventKind, added_discs
 from discsim.model import image_steps
-from discsim.physics.dynamics import advance
+from discsim.physics.dynamics import advance, advance_many
 
 __all__ = ["LastRecords", "check_times", "log_start", "positions_from_log", "reconstruct", "replay"]
 
@@ -59,6 +59,7 @@ def reconstruct(
     images0=None,
     gravity=None,
     masses=None,
+    drag: float = 0.0,
 ) -> np.ndarray:
     """Exact positions of every disc at ``times`` from an initial state and a log.
 
@@ -81,6 +82,8 @@ def reconstruct(
             event with velocity exactly zero (the initial state and an edit always fall). A disc that an event
             stops dead while it still falls (possible only in contrived, exactly symmetric collisions) is taken at
             rest.
+        drag: the run's drag ``gamma`` (1 / time; 0: none): exponential flight between records
+            (:func:`discsim.physics.dynamics.advance_many`).
 
     Returns:
         ``(T, N, 2)`` positions. An event exactly at a requested time counts as
@@ -95,14 +98,14 @@ def reconstruct(
     periodic = box is not None and box.periodic
     falls = _falling(disc, state, kind[0], gravity, masses) if falling else None
     if unwrapped and periodic and (len(state) > n or images0 is not None):
-        state[:, :2] += _image_counts(disc, t_rec, state, starts, box.size, images0, gravity, falls) * box.size
+        state[:, :2] += _image_counts(disc, t_rec, state, starts, box.size, images0, gravity, falls, drag) * box.size
     out = np.empty((len(times), n, 2))
     for d in range(n):
         lo, hi = starts[d], starts[d + 1]
         k = lo + np.searchsorted(t_rec[lo:hi], times, side="right") - 1
         k = np.maximum(k, lo)
         dt = (times - t_rec[k])[:, None]
-        x, y = _flight(state[k], dt[:, 0], gravity, None if falls is None else falls[k])
+        x, y = _flight(state[k], dt[:, 0], gravity, None if falls is None else falls[k], drag)
         out[:, d, 0], out[:, d, 1] = x, y
     if periodic and not unwrapped:
         out = box.wrap(out)
@@ -120,12 +123,19 @@ def _falling(disc, state, kind, gravity, masses) -> np.ndarray:
     return moving
 
 
-def _flight(state, dt, gravity, falls) -> tuple[np.ndarray, np.ndarray]:
-    """Centres ``dt`` after records ``state`` ``(K, 4)``: free flight, or under ``gravity`` where ``falls``."""
-    x, y, _, _ = advance(state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt)
+def _flight(state, dt, gravity, falls, drag: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Centres ``dt`` after records ``state`` ``(K, 4)``: free flight, or under ``gravity`` where ``falls``, under
+    ``drag``."""
+    if drag:
+        x, y, _, _ = advance_many(state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt, 0.0, 0.0, drag)
+    else:
+        x, y, _, _ = advance(state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt)
     if falls is not None:
-        fx, fy, _, _ = advance(
-            state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt, float(gravity[0]), float(gravity[1])
+        gx, gy = float(gravity[0]), float(gravity[1])
+        fx, fy, _, _ = (
+            advance_many(state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt, gx, gy, drag)
+            if drag
+            else advance(state[:, 0], state[:, 1], state[:, 2], state[:, 3], dt, gx, gy)
         )
         x, y = np.where(falls, fx, x), np.where(falls, fy, y)
     return x, y
@@ -298,7 +308,7 @@ class LastRecords:
         return out
 
 
-def _image_counts(disc, t_rec, state, starts, size, images0=None, gravity=None, falls=None) -> np.ndarray:
+def _image_counts(disc, t_rec, state, starts, size, images0=None, gravity=None, falls=None, drag=0.0) -> np.ndarray:
     """``(R, 2)`` whole box lengths (counts, integers as floats) to add to each record so that every disc's
     path is continuous; the shift of a record is ``counts * size``.
 
@@ -307,7 +317,7 @@ def _image_counts(disc, t_rec, state, starts, size, images0=None, gravity=None, 
     Each disc starts from ``images0`` ``(N, 2)`` (default zero). The counts are summed as integers, so a
     log read in pieces (:meth:`LastRecords.after`) gives the same shifts, bit for bit, as read whole.
     """
-    x, y = _flight(state[:-1], t_rec[1:] - t_rec[:-1], gravity, None if falls is None else falls[:-1])
+    x, y = _flight(state[:-1], t_rec[1:] - t_rec[:-1], gravity, None if falls is None else falls[:-1], drag)
     flown = np.column_stack([x, y])
     steps = np.nan_to_num(image_steps(flown, state[1:, :2], size))  # NaN: not there yet, or gone
     first = np.zeros(len(state) + 1, dtype=bool)
@@ -348,8 +358,9 @@ def log_start(events, discs, ids=None) -> tuple[np.ndarray, ...]:
 
 
 def positions_from_log(
-    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None, gravity=None
-):
+    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None,
+    gravity=None, drag: float = 0.0,
+):  # fmt: skip
     """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``.
 
     Checks ``times`` first (:func:`check_times`, naming the ``span``). Returns positions ``(T, M, 2)``: one
@@ -358,8 +369,9 @@ def positions_from_log(
     times = check_times(times, start_time, end_time, span)
     positions, velocities, _, masses, _ = log_start(events, discs, ids)
     return reconstruct(
-        events, positions, velocities, start_time, times, box, unwrapped=unwrapped, gravity=gravity, masses=masses
-    )
+        events, positions, velocities, start_time, times, box, unwrapped=unwrapped, gravity=gravity, masses=masses,
+        drag=drag,
+    )  # fmt: skip
 
 
 def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, velocities: bool = False):

@@ -94,6 +94,7 @@ class EventRecord:
             unwrapped=unwrapped,
             ids=ids,
             gravity=self._gravity(),
+            drag=getattr(getattr(self, "laws", None), "drag", 0.0),
         )
 
     def _gravity(self):

@@ -14,7 +14,7 @@ from __future__ import annotations
 from discsim import model
 from discsim._compiled import compile_from_source, interpret, jit
 from discsim._numba import numba
-from discsim.physics import dynamics, laws, roots
+from discsim.physics import damped, dynamics, laws, roots
 from discsim.physics.sources import boundaries, pairs
 
 __all__ = [
@@ -48,8 +48,10 @@ LAWS = ("collide", "reflect", "closest_point_on_segment", "reflect_off_segment")
 _SOURCES = (
     model.minimum_image_1d,
     *roots.PARTS,
+    *damped.PARTS,
+    *(getattr(dynamics, name) for name in DYNAMICS if name != "segment_time_of_impact"),
     dynamics._falling_segment_time,
-    *(getattr(dynamics, name) for name in DYNAMICS),
+    dynamics.segment_time_of_impact,
     *(getattr(laws, name) for name in LAWS),
     laws.rough_impulse,
     pairs.predict,

@@ -28,13 +28,14 @@ WIND = 0.75  # length / time, along x
 
 
 # --8<-- [start:law]
-def advance(x, y, vx, vy, dt, ax=0.0, ay=0.0):
+def advance(x, y, vx, vy, dt, ax=0.0, ay=0.0, drag=0.0):
     """Free flight plus the wind: the centre drifts at (vx + WIND, vy); the disc's own velocity is unchanged.
-    (A law takes the disc's acceleration last, as free flight does; this toy runs without gravity.)"""
+    (A law takes the disc's acceleration, then the drag, last, as free flight does; this toy runs without
+    either.)"""
     return x + (vx + WIND) * dt, y + vy * dt, vx, vy
 
 
-def exit_x(x, vx, lo, hi, a=0.0):
+def exit_x(x, vx, lo, hi, a=0.0, drag=0.0):
     """Time to leave the slab lo <= x <= hi when moving at vx + WIND along x (the side: 1 up, -1 down)."""
     v = vx + WIND
     if v > 0.0:

@@ -88,6 +88,10 @@ class EventDriven(Turning, RunStops, Engine):
             (energy conserving); between, energy lost. The impulse at the contact point turns the discs
             (``discs.spins``, ``discs.inertia``; :attr:`spins`, :attr:`angles`, :attr:`spin_events`); walls and
             segments are as rough as the discs (``docs/laws.md``).
+        drag: a linear drag ``gamma`` >= 0 (1 / time) on every disc of finite mass, the force ``-m gamma v``:
+            exact exponential flight between events, towards the terminal velocity ``gravity / gamma``
+            (``docs/laws.md``); 0: none. Its energy loss is not in :attr:`dissipated` (which counts the
+            collisions'): it is the rest of the drop in :meth:`energy`.
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
@@ -131,8 +135,9 @@ class EventDriven(Turning, RunStops, Engine):
         tc: float = 0.0,
         rest_speed: float | None = None,
         roughness: float = -1.0,
+        drag: float = 0.0,
     ):
-        laws = Laws.build(gravity, restitution, tc, rest_speed, roughness)
+        laws = Laws.build(gravity, restitution, tc, rest_speed, roughness, drag)
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
         self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend, laws)

@@ -12,7 +12,7 @@ import numpy as np
 
 from discsim.engines.base import EngineState
 from discsim.errors import CheckpointError
-from discsim.physics.dynamics import advance
+from discsim.physics.dynamics import advance_many
 
 __all__ = ["EventDrivenState"]
 
@@ -223,19 +223,21 @@ class EventDrivenState(EngineState):
             "predictions": self.predictions,
         }
 
-    def positions_at(self, time: float, gravity=None, falls: np.ndarray | None = None) -> np.ndarray:
+    def positions_at(self, time: float, gravity=None, falls: np.ndarray | None = None, drag: float = 0.0) -> np.ndarray:
         """``(N, 2)`` centres at ``time`` (absolute), not wrapped.
 
         Args:
             gravity: the run's ``(gx, gy)`` (None: none).
             falls: ``(N,)`` bool, the discs that fall (finite mass and not at rest); None: all that are not at
                 rest.
+            drag: the run's drag ``gamma`` (0: none).
         """
         t = time - self.epoch
         (x0, y0), (vx, vy) = self.ref_positions.T, self.velocities.T
-        x, y, _, _ = advance(x0, y0, vx, vy, t - self.ref_times)
+        x, y, _, _ = advance_many(x0, y0, vx, vy, t - self.ref_times, 0.0, 0.0, drag)
         if gravity is not None and tuple(gravity) != (0.0, 0.0):
             falls = self.resting == 0 if falls is None else falls
-            fx, fy, _, _ = advance(x0, y0, vx, vy, t - self.ref_times, float(gravity[0]), float(gravity[1]))
+            gx, gy = float(gravity[0]), float(gravity[1])
+            fx, fy, _, _ = advance_many(x0, y0, vx, vy, t - self.ref_times, gx, gy, drag)
             x, y = np.where(falls, fx, x), np.where(falls, fy, y)
         return np.column_stack([x, y]).reshape(-1, 2)

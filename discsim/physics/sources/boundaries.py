@@ -31,8 +31,9 @@ PLUS_X, MINUS_X, PLUS_Y, MINUS_Y = 0, 1, 2, 3
 
 
 def predict_x(
-    x: float, vx: float, r: float, lo: float, hi: float, width: float, wall_lo: bool, wall_hi: bool, a: float = 0.0
-) -> tuple[float, int, int]:
+    x: float, vx: float, r: float, lo: float, hi: float, width: float, wall_lo: bool, wall_hi: bool, a: float = 0.0,
+    drag: float = 0.0,
+) -> tuple[float, int, int]:  # fmt: skip
     """The next crossing of the cell's edge ``lo`` or ``hi`` along x, or the wall beyond it.
 
     Args:
@@ -42,12 +43,13 @@ def predict_x(
         width: the box's width.
         wall_lo, wall_hi: whether a wall stands beyond ``lo`` (``hi``).
         a: the acceleration along x (gravity; default none).
+        drag: the drag ``gamma`` (1 / time; default none).
 
     Returns:
         ``(t, kind, other)``: the time from now (not clamped), ``WALL`` or ``CROSSING`` and its ``other``;
         ``(inf, CROSSING, 0)`` when the disc does not move along x.
     """
-    t, side = exit_x(x, vx, r if wall_lo else lo, width - r if wall_hi else hi, a)
+    t, side = exit_x(x, vx, r if wall_lo else lo, width - r if wall_hi else hi, a, drag)
     if side > 0:
         return (t, WALL, 0) if wall_hi else (t, CROSSING, PLUS_X)
     if side < 0:
@@ -56,10 +58,11 @@ def predict_x(
 
 
 def predict_y(
-    y: float, vy: float, r: float, lo: float, hi: float, height: float, wall_lo: bool, wall_hi: bool, a: float = 0.0
-) -> tuple[float, int, int]:
+    y: float, vy: float, r: float, lo: float, hi: float, height: float, wall_lo: bool, wall_hi: bool, a: float = 0.0,
+    drag: float = 0.0,
+) -> tuple[float, int, int]:  # fmt: skip
     """:func:`predict_x` along y (a wall hit's ``other`` is 1)."""
-    t, side = exit_y(y, vy, r if wall_lo else lo, height - r if wall_hi else hi, a)
+    t, side = exit_y(y, vy, r if wall_lo else lo, height - r if wall_hi else hi, a, drag)
     if side > 0:
         return (t, WALL, 1) if wall_hi else (t, CROSSING, PLUS_Y)
     if side < 0:

@@ -17,7 +17,7 @@ __all__ = ["predict", "resolve"]
 def predict(
     xj: float, yj: float, vxj: float, vyj: float, dtj: float, rj: float,
     offx: float, offy: float, vxi: float, vyi: float, ri: float,
-    axj: float = 0.0, ayj: float = 0.0, dax: float = 0.0, day: float = 0.0,
+    axj: float = 0.0, ayj: float = 0.0, dax: float = 0.0, day: float = 0.0, drag: float = 0.0,
 ) -> float:  # fmt: skip
     """Time from now until disc ``j`` meets disc ``i``, or ``inf``.
 
@@ -33,9 +33,10 @@ def predict(
         vxi, vyi: disc ``i``'s velocity now.
         axj, ayj: disc ``j``'s acceleration (gravity if it falls; default none).
         dax, day: ``j``'s acceleration minus ``i``'s (zero when both fall or neither does).
+        drag: the drag ``gamma`` of every disc (1 / time; default none).
     """
-    xj, yj, vxj, vyj = advance(xj, yj, vxj, vyj, dtj, axj, ayj)
-    return pair_time_of_impact(xj + offx, yj + offy, vxj - vxi, vyj - vyi, ri + rj, dax, day)
+    xj, yj, vxj, vyj = advance(xj, yj, vxj, vyj, dtj, axj, ayj, drag)
+    return pair_time_of_impact(xj + offx, yj + offy, vxj - vxi, vyj - vyi, ri + rj, dax, day, drag)
 
 
 def resolve(

@@ -345,18 +345,20 @@ class NumbaBackend(CompiledReads):
         lp, rec = self._lp, self._rec
         k = int(np.flatnonzero(self._order == i)[0])
         t = self.time - float(self._floats[lp.F_EPOCH])
-        if position is None:
-            falls = self.laws.falls and rec[k, 6] != np.inf and self._rest[k] == 0
-            x, y, _, _ = self._law_of_motion.advance(
-                float(rec[k, 0]),
-                float(rec[k, 1]),
-                float(rec[k, 2]),
-                float(rec[k, 3]),
-                t - float(rec[k, 4]),
-                *(self.laws.gravity if falls else (0.0, 0.0)),
-            )
-            cell = int(self._cell[k])
+        falls = self.laws.falls and rec[k, 6] != np.inf and self._rest[k] == 0
+        gx, gy = self.laws.gravity if falls else (0.0, 0.0)
+        drag = self.laws.drag
+        x0, y0, vx0, vy0 = (float(v) for v in rec[k, :4])
+        args = (x0, y0, vx0, vy0, t - float(rec[k, 4]), gx, gy)
+        if drag:
+            x, y, ux, uy = dynamics.advance(*args, drag)
+            if rec[k, 6] != np.inf:  # what the drag took over the flight the edit ends
+                work = gx * (x - x0) + gy * (y - y0)
+                self._floats[lp.F_LOST] += rec[k, 6] * (0.5 * (vx0 * vx0 + vy0 * vy0 - ux * ux - uy * uy) + work)
         else:
+            x, y, _, _ = self._law_of_motion.advance(*args)
+        cell = int(self._cell[k])
+        if position is not None:
             x, y = float(position[0]), float(position[1])
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
         held: list[int] = []

@@ -50,13 +50,14 @@ from discsim.engines.event_driven.numba.support import (  # noqa: F401
     X,
     Y,
     accel,
+    drag_loss,
     restitution,
     spin_energy,
     supported,
     turn,
 )
 from discsim.events import EventKind
-from discsim.laws import BETA, GX, GY, REST_SPEED, TC
+from discsim.laws import BETA, DRAG, GX, GY, REST_SPEED, TC
 from discsim.physics.compiled import (
     advance,
     closest_point_on_segment,
@@ -115,12 +116,13 @@ def predict(
     width = edges[nx]
     height = edges[nx + 1 + ny]
     ri = rec[i, R]
-    gx = gy = 0.0
+    gx = gy = drag = 0.0
     if LAWS:  # a constant: the loop of the default laws compiles none of this (see with_laws)
         gx, gy = edges[nx + ny + 2 + GX], edges[nx + ny + 2 + GY]
+        drag = edges[nx + ny + 2 + DRAG]
     gravity = LAWS and (gx != 0.0 or gy != 0.0)
     axi, ayi = accel(i, gravity, gx, gy, rec, rest)
-    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
+    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
     c = cell[i]
     cx = c // ny
     cy = c - cx * ny
@@ -173,7 +175,7 @@ def predict(
                     axj, ayj = accel(j, gravity, gx, gy, rec, rest)
                 tij = pair_predict(
                     rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], rec[j, R], offx, offy, vxi, vyi, ri,
-                    axj, ayj, axj - axi, ayj - ayi,
+                    axj, ayj, axj - axi, ayj - ayi, drag,
                 )  # fmt: skip
                 if tij < best:
                     best = tij
@@ -197,17 +199,20 @@ def predict(
     # 2. The next wall, segment or cell boundary.
     walled = not periodic
     best, kind, other = predict_x(
-        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1, axi
+        xi, vxi, ri, edges[cx], edges[cx + 1], width, walled and cx == 0, walled and cx == nx - 1, axi, drag
     )
     ty, kind_y, other_y = predict_y(
-        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1, ayi
-    )
+        yi, vyi, ri, edges[nx + 1 + cy], edges[nx + 2 + cy], height, walled and cy == 0, walled and cy == ny - 1, ayi,
+        drag,
+    )  # fmt: skip
     if ty < best:
         best, kind, other = ty, kind_y, other_y
     for m in range(seg_start[c], seg_start[c + 1]):
         k = seg_idx[m]
         if k != -2 - exclude:  # not the segment just left
-            ts = segment_time_of_impact(xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi)
+            ts = segment_time_of_impact(
+                xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi, drag
+            )
             if ts < best:
                 best, kind, other = ts, SEGMENT, k
     if best < 0.0:
@@ -335,9 +340,9 @@ def run_events(
     width = edges[nx]
     height = edges[nx + 1 + ny]
     law = edges[nx + ny + 2 :]  # the laws' numbers follow the cells' edges
-    gx = gy = 0.0
+    gx = gy = drag = 0.0
     if LAWS:
-        gx, gy = law[GX], law[GY]
+        gx, gy, drag = law[GX], law[GY], law[DRAG]
     gravity = LAWS and (gx != 0.0 or gy != 0.0)
     beta = -1.0
     if LAWS:
@@ -400,8 +405,11 @@ def run_events(
             mi, mj = rec[i, M], rec[j, M]
             axi, ayi = accel(i, gravity, gx, gy, rec, rest)
             axj, ayj = accel(j, gravity, gx, gy, rec, rest)
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
-            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], axj, ayj)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
+            xj, yj, vxj, vyj = advance(rec[j, X], rec[j, Y], rec[j, VX], rec[j, VY], t - rec[j, T], axj, ayj, drag)
+            if LAWS and drag != 0.0:  # what the drag took over the flights this collision ends
+                floats[F_LOST] += drag_loss(i, axi, ayi, rec, xi, yi, vxi, vyi)
+                floats[F_LOST] += drag_loss(j, axj, ayj, rec, xj, yj, vxj, vyj)
             e = restitution(i, j, t + epoch, law, etab, egroup, tlast) if LAWS else 1.0
             dx, dy, uxi, uyi, uxj, uyj = pair_resolve(
                 xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic, e
@@ -515,7 +523,9 @@ def run_events(
             last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j
         elif kind == WALL or kind == SEGMENT:
             axi, ayi = accel(i, gravity, gx, gy, rec, rest)
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
+            if LAWS and drag != 0.0:
+                floats[F_LOST] += drag_loss(i, axi, ayi, rec, xi, yi, vxi, vyi)
             e = restitution(i, i, t + epoch, law, etab, egroup, tlast) if LAWS else 1.0
             wx, wy = vxi, vyi
             if kind == SEGMENT:

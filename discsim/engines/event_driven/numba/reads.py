@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from discsim.physics.dynamics import advance_many
+
 __all__ = ["CompiledReads"]
 
 
@@ -90,8 +92,21 @@ class CompiledReads:
 
     @property
     def dissipated(self) -> float:
-        """Kinetic energy lost in collisions (restitution) and by discs coming to rest, since the start."""
-        return float(self._floats[self._lp.F_LOST])
+        """Kinetic energy lost in collisions (restitution), by discs coming to rest and to drag, since the start
+        (drag's over the flights still under way too, up to ``time``)."""
+        lost = float(self._floats[self._lp.F_LOST])
+        if self.laws.drag == 0.0:
+            return lost
+        x, y, vx, vy = self._now()
+        rank = self._rank()
+        rec = self._rec[rank]
+        moving = np.isfinite(rec[:, 6])
+        m, (x0, y0, vx0, vy0) = rec[moving, 6], rec[moving, :4].T
+        gx, gy = self.laws.gravity
+        falls = (self._rest[rank] == 0)[moving]
+        work = np.where(falls, gx * (x[moving] - x0) + gy * (y[moving] - y0), 0.0)
+        kinetic = 0.5 * ((vx0 * vx0 + vy0 * vy0) - (vx[moving] ** 2 + vy[moving] ** 2))
+        return lost + float(np.sum(m * (kinetic + work)))
 
     def turning(self) -> tuple[np.ndarray, np.ndarray]:
         """``(spins, angles)``, each ``(N,)`` at ``time`` in the caller's numbering (new arrays)."""
@@ -120,11 +135,14 @@ class CompiledReads:
         t = self.time - float(self._floats[self._lp.F_EPOCH])
         rank = self._rank()
         rx, ry, vx, vy, tr = self._rec[rank, :5].T
-        advance = self._law_of_motion.advance
-        x, y, vx, vy = advance(rx, ry, vx, vy, t - tr)
+        drag = self.laws.drag
+        advance = self._law_of_motion.advance if drag == 0.0 else advance_many
+        x, y, vx, vy = advance(rx, ry, vx, vy, t - tr, 0.0, 0.0, drag) if drag else advance(rx, ry, vx, vy, t - tr)
         if self.laws.falls:
             falls = (self._rec[rank, 6] != np.inf) & (self._rest[rank] == 0)
-            fx, fy, fvx, fvy = advance(rx, ry, self._rec[rank, 2], self._rec[rank, 3], t - tr, *self.laws.gravity)
+            fx, fy, fvx, fvy = advance(
+                rx, ry, self._rec[rank, 2], self._rec[rank, 3], t - tr, *self.laws.gravity, *((drag,) if drag else ())
+            )
             x, y, vx, vy = (np.where(falls, f, v) for f, v in ((fx, x), (fy, y), (fvx, vx), (fvy, vy)))
         return x, y, vx, vy
 

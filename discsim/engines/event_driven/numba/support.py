@@ -3,6 +3,7 @@
 - :func:`accel`: a disc's acceleration now (gravity, unless it has none, is an obstacle or rests);
 - :func:`restitution`: the coefficient of a collision (one number, the pair of groups', 1 under the TC model);
 - :func:`turn`, :func:`spin_energy`: rough discs' angles and rotational energy;
+- :func:`drag_loss`: the energy drag took from a disc over a flight;
 - :func:`supported`: the discs at rest that a support holds up (they fall again when it goes).
 
 Compiled into :mod:`discsim.engines.event_driven.numba.loop`'s functions (``inline``) or called by them.
@@ -15,7 +16,7 @@ import math
 from discsim._compiled import inline, jit
 from discsim.laws import PER_GROUP, TC, E
 
-__all__ = ["accel", "restitution", "spin_energy", "supported", "turn"]
+__all__ = ["accel", "drag_loss", "restitution", "spin_energy", "supported", "turn"]
 
 INF = math.inf
 # Columns of a disc's row in ``rec``.
@@ -30,6 +31,19 @@ def accel(k, gravity, gx, gy, rec, rest):
     if gravity and rec[k, M] != INF and rest[k] == 0:
         return gx, gy
     return 0.0, 0.0
+
+
+@inline
+def drag_loss(k, gx, gy, rec, x, y, vx, vy):
+    """The energy drag took from disc ``k`` over its flight from its record (``rec[k]``) to ``(x, y)``, ``(vx, vy)``
+    under the acceleration ``(gx, gy)`` it had: its kinetic energy lost plus the work gravity did on it
+    (``m g . dr``); 0 for an obstacle. What the drag takes, counted at each event that ends a flight, so that
+    ``energy() + dissipated`` stays constant under drag too."""
+    m = rec[k, M]
+    if m == INF:
+        return 0.0
+    vx0, vy0 = rec[k, VX], rec[k, VY]
+    return m * (0.5 * ((vx0 * vx0 + vy0 * vy0) - (vx * vx + vy * vy)) + gx * (x - rec[k, X]) + gy * (y - rec[k, Y]))
 
 
 @inline

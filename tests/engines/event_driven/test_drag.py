@@ -1,0 +1,190 @@
+"""Linear drag in the event-driven engine (issue 27, item 4): closed forms, a brute-force oracle in lock-step,
+energy bookkeeping, both backends bit for bit, trajectories, checkpoints, bad input."""
+
+import math
+
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim.errors import InvalidArgumentError
+from discsim.physics.damped import spans_many
+
+G = 9.81
+BOX = ds.Box(10.0, 10.0)
+
+
+def ball(x, y, vx=0.0, vy=0.0, r=1.0):
+    return ds.Discs([[x, y]], [[vx, vy]], radii=r)
+
+
+def times(sim, kind=None):
+    return np.array([e["time"] for e in sim.events if kind is None or e["kind"] == kind])
+
+
+# --- closed forms ---------------------------------------------------------------------------------------------
+def test_a_disc_reaches_a_wall_at_the_exact_time_and_stops_short_of_the_next(every_backend):
+    # From x = 2 at 8 under gamma = 0.5: the wall stops the centre at 9, reached when tau = 7 / 8; back at 4.5,
+    # it would stop 9 farther on, but reaches x = 1 when tau = 8 / 4.5.
+    gamma = 0.5
+    sim = ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=gamma).run(until=30.0)
+    first = -math.log1p(-gamma * 7.0 / 8.0) / gamma
+    second = first - math.log1p(-gamma * 8.0 / 4.5) / gamma
+    assert times(sim).tolist() == pytest.approx([first, second], rel=1e-14)
+    # After the second bounce at 0.5: it stops at 1 + 0.5 / 0.5 = 2 without another event.
+    assert sim.positions[0] == pytest.approx([2.0 - 0.5 * math.exp(-gamma * (30.0 - second)) / gamma, 5.0])
+    assert sim.velocities[0, 0] == pytest.approx(0.5 * math.exp(-gamma * (30.0 - second)), rel=1e-12)
+
+
+def test_a_ball_falls_at_its_terminal_velocity(every_backend):
+    gamma = 4.0
+    sim = ds.EventDriven(ball(5.0, 1000.0, 2.0, 0.0), ds.Box(10.0, 1001.0), gravity=(0.0, -G), drag=gamma)
+    sim.run(until=10.0)
+    assert sim.velocities[0] == pytest.approx([2.0 * math.exp(-40.0), -G / gamma], rel=1e-12)
+    # Height: 1000 - (g / gamma) (t - tau(t)).
+    assert sim.positions[0, 1] == pytest.approx(1000.0 - G / gamma * (10.0 - (1 - math.exp(-40.0)) / gamma), rel=1e-14)
+
+
+def test_two_discs_meet_at_free_flights_contact_in_the_transformed_time(every_backend):
+    gamma = 0.2
+    discs = ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], radii=1.0)
+    sim = ds.EventDriven(discs, BOX, drag=gamma, gravity=(0.0, -1e-3))  # both fall: gravity cancels
+    event = sim.step()
+    assert event.kind == "collision"
+    assert event.time == pytest.approx(-math.log1p(-gamma * 2.0) / gamma, rel=1e-13)
+
+
+# --- the oracle -------------------------------------------------------------------------------------------------
+def _first(values_at, horizon):
+    """The first time in (0, horizon] where ``values_at(t) <= 0``, by a dense grid and bisection (or inf)."""
+    grid = np.concatenate([np.geomspace(1e-9, horizon, 3000), np.linspace(0.0, horizon, 20001)[1:]])
+    grid.sort()
+    hit = np.flatnonzero(values_at(grid) <= 0.0)
+    if not len(hit):
+        return math.inf
+    k = hit[0]
+    lo, hi = (grid[k - 1] if k else 0.0), grid[k]
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if values_at(np.array([mid]))[0] <= 0.0 else (mid, hi)
+    return hi
+
+
+def next_event_under_drag(pos, vel, radii, masses, box, gravity, gamma, resting):
+    """``(dt, kind, i, j)`` of the earliest event, by brute force over every pair and wall."""
+    g = np.asarray(gravity, dtype=float)
+    acc = np.where((np.isfinite(masses) & ~np.asarray(resting, dtype=bool))[:, None], g, 0.0)
+    horizon = 50.0
+    best = (math.inf, None, -1, -1)
+
+    def path(k, t):
+        tau, s, _ = spans_many(t, gamma)
+        p, v, a = pos[k][:, None], vel[k][:, None], acc[k][:, None]
+        return p + v * tau + a * s, v * (1 - gamma * tau) + a * tau
+
+    n = len(radii)
+    for i in range(n):
+        for j in range(i + 1, n):
+            sigma = radii[i] + radii[j]
+
+            def gap(t, i=i, j=j, sigma=sigma):
+                (pi, vi), (pj, vj) = path(i, t), path(j, t)
+                d, w = pj - pi, vj - vi
+                closing = (d * w).sum(axis=0) < 0.0
+                return np.where(closing, np.hypot(*d) - sigma, 1.0)
+
+            t = _first(gap, horizon)
+            if t < best[0]:
+                best = (t, "collision", i, j)
+        for axis, length in enumerate(box.size):
+            r = radii[i]
+
+            def beyond(t, i=i, axis=axis, length=length, r=r):
+                p, v = path(i, t)
+                q, u = p[axis], v[axis]
+                return np.where(((q <= r) & (u < 0)) | ((q >= length - r) & (u > 0)), -1.0, 1.0)
+
+            t = _first(beyond, horizon)
+            if t < best[0]:
+                best = (t, "wall", i, -1)
+    return best
+
+
+@pytest.mark.parametrize("gravity", [(0.0, 0.0), (0.5, -3.0)])
+def test_a_gas_under_drag_follows_the_oracle(every_backend, gravity):
+    rng = np.random.default_rng(11)
+    pos, rad = [], []
+    while len(pos) < 10:
+        r = rng.uniform(0.5, 0.9)
+        p = rng.uniform(r, 10.0 - r, size=2)
+        if all(np.hypot(*(p - q)) > r + s + 1e-6 for q, s in zip(pos, rad)):
+            pos.append(p)
+            rad.append(r)
+    masses = rng.uniform(0.5, 2.0, size=10)
+    masses[:2] = np.inf
+    vel = rng.normal(scale=4.0, size=(10, 2))
+    vel[:2] = 0.0
+    discs = ds.Discs(np.array(pos), vel, np.array(rad), masses)
+    sim = ds.EventDriven(discs, BOX, gravity=gravity, drag=0.2, restitution=0.9)
+    for _ in range(40):
+        t0 = sim.time
+        dt, kind, i, j = next_event_under_drag(
+            sim.positions, sim.velocities, discs.radii, discs.masses, sim.box, gravity, 0.2, sim.resting
+        )
+        event = sim.step()
+        assert event.time == pytest.approx(t0 + dt, rel=1e-7, abs=1e-8), (event, t0 + dt, kind, i, j)
+        assert event.kind == kind and {event.i, event.j} == {i, j}, (event, kind, i, j)
+        sim._check()
+
+
+# --- energy, backends, trajectories, checkpoints -------------------------------------------------------------------
+@pytest.mark.parametrize("gravity, e", [((0.0, 0.0), 1.0), ((0.0, -G), 1.0), ((2.0, -3.0), 0.8)])
+def test_energy_plus_what_drag_and_collisions_took_is_constant_and_backends_agree(every_backend, gravity, e):
+    discs, box = ds.random_gas(40, 0.3, seed=4, periodic=False)
+    sim = ds.EventDriven(discs, box, gravity=gravity, drag=0.05, restitution=e, tc=1e-3)
+    e0 = sim.energy()
+    sim.run(events=1500)
+    assert sim.dissipated > 0.0
+    assert sim.energy() + sim.dissipated == pytest.approx(e0, rel=1e-9)
+    sim.run(until=sim.time + 0.37)  # between events too (the flights under way)
+    assert sim.energy() + sim.dissipated == pytest.approx(e0, rel=1e-9)
+    sim._check()
+    if every_backend == "numba":  # the pure-Python backend (the loop's source, interpreted): bit for bit
+        python = ds.EventDriven(discs, box, gravity=gravity, drag=0.05, restitution=e, tc=1e-3, backend="python")
+        python.run(events=1500)
+        assert python.events.tobytes() == sim.events[: len(python.events)].tobytes()
+
+
+def test_trajectories_follow_the_exponential_flight(every_backend):
+    gamma = 0.3
+    sim = ds.EventDriven(ball(2.0, 8.0, 5.0, 1.0), BOX, gravity=(0.0, -G), drag=gamma).run(until=6.0)
+    ts = np.linspace(0.0, 6.0, 37)
+    path = sim.trajectory(ts)[:, 0]
+    for k, t in enumerate(ts):  # against a fresh run stopped at each time
+        here = ds.EventDriven(ball(2.0, 8.0, 5.0, 1.0), BOX, gravity=(0.0, -G), drag=gamma).run(until=float(t))
+        assert path[k] == pytest.approx(here.positions[0], abs=1e-10)
+
+
+def test_a_run_under_drag_continues_from_a_checkpoint_bit_for_bit(every_backend, tmp_path):
+    discs, box = ds.random_gas(30, 0.3, seed=9, periodic=False)
+    laws = {"gravity": (0.0, -2.0), "restitution": 0.9, "tc": 1e-3, "drag": 0.1}
+    whole = ds.EventDriven(discs, box, **laws).run(events=600)
+    half = ds.EventDriven(discs, box, **laws).run(events=300)
+    half.save(tmp_path / "half.dsc")
+    resumed = ds.load(tmp_path / "half.dsc").run(events=300)
+    assert resumed.laws == whole.laws and resumed.laws.drag == 0.1
+    assert resumed.events[-300:].tobytes() == whole.events[-300:].tobytes()  # (wall records hold NaNs)
+    assert resumed.dissipated == pytest.approx(whole.dissipated, rel=1e-12)
+
+
+def test_drag_zero_is_todays_physics():
+    discs, box = ds.random_gas(30, 0.3, seed=1)
+    plain = ds.EventDriven(discs, box, backend="python").run(events=300)
+    spelled = ds.EventDriven(discs, box, backend="python", drag=0.0).run(events=300)
+    assert spelled.laws.default and plain.events.tobytes() == spelled.events.tobytes()
+
+
+@pytest.mark.parametrize("drag", [-0.1, math.nan, math.inf, "strong", None])
+def test_bad_drag_is_refused_naming_it(drag):
+    with pytest.raises(InvalidArgumentError, match="drag"):
+        ds.EventDriven(ball(5.0, 5.0), BOX, drag=drag)

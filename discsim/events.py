@@ -36,7 +36,8 @@ class EventKind(IntEnum):
 
     The log holds ``COLLISION`` (disc-disc), ``WALL`` (a wall or a segment
     hit), ``SET`` (a disc changed by the user: ``set_velocities``, ``apply_impulse``,
-    ``set_positions``; ``j`` is -1), ``ADD`` and ``REMOVE`` (a disc added by ``add_discs`` or removed by
+    ``set_positions``; or, under gravity, a disc at rest that falls again because what held it up went: where it
+    is, velocity zero; ``j`` is -1), ``ADD`` and ``REMOVE`` (a disc added by ``add_discs`` or removed by
     ``remove_discs``; ``j`` is -1; see :class:`EventLog` for their fields) only; ``CROSSING`` (a disc
     enters another cell) and ``SEGMENT`` (a segment hit, logged as ``WALL``) live in the engines' queues.
     """

@@ -326,6 +326,26 @@ def test_discs_held_up_by_a_support_fall_when_it_goes(every_backend, edit):
     assert sim.resting.all() and _floating(sim) == []
 
 
+@pytest.mark.parametrize("edit", ["move", "remove", "knock"])
+def test_the_log_says_when_a_disc_at_rest_falls_again(every_backend, edit):
+    # B rests on A; A goes (an edit, or a hit that wakes it): B falls from where it rested, at that time, and the
+    # log says so (a SET record), so that trajectory() follows its fall rather than keeping it in mid-air.
+    sim = _stack()
+    t0 = sim.time
+    if edit == "move":
+        sim.set_positions([0], [[2.0, 1.0]])
+    elif edit == "remove":
+        sim.remove_discs([0])
+    else:
+        sim.add_discs(ds.Discs([[1.0, 1.3]], [[20.0, 0.0]], radii=1.0))
+    ts = t0 + np.linspace(0.0, 0.5, 11)[1:]
+    for t in ts:
+        sim.run(until=float(t))
+        assert sim.trajectory([t])[0, 1] == pytest.approx(sim.positions[0 if edit == "remove" else 1], abs=1e-9)
+    sets = [e for e in sim.events if e["kind"] == ds.events.SET and e["i"] == 1]
+    assert sets and all(e["vxi"] == 0.0 and e["vyi"] == 0.0 for e in sets)  # (knock: the add wakes B too)
+
+
 def test_a_disc_skimming_the_floor_comes_to_rest_and_its_energy_is_counted(every_backend):
     # There is no sliding contact: a bounce slower than rest_speed ends in rest even at e = 1, fast along the
     # floor or not (docs/laws.md), and the kinetic energy it had is counted in dissipated.

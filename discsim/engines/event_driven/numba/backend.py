@@ -301,14 +301,15 @@ class NumbaBackend(CompiledReads):
         limit = -1 if limit is None else int(limit)
         crossings = -1 if crossings is None else int(crossings)
         recording = log is not None
-        if recording and self._events is None:
+        if recording and (self._events is None or len(self._events[0]) < self._log_rows()):
+            rows = self._log_rows()
             self._events = (
-                np.empty(LOG_ROWS),
-                np.empty(LOG_ROWS, dtype=np.int8),
-                np.empty(LOG_ROWS, dtype=np.int64),
-                np.empty(LOG_ROWS, dtype=np.int64),
-                np.empty((LOG_ROWS, 8)),
-                np.empty((LOG_ROWS, 2)),
+                np.empty(rows),
+                np.empty(rows, dtype=np.int8),
+                np.empty(rows, dtype=np.int64),
+                np.empty(rows, dtype=np.int64),
+                np.empty((rows, 8)),
+                np.empty((rows, 2)),
             )
         events: tuple[np.ndarray, ...] = self._events if self._events is not None and recording else _NO_EVENTS
         args = self._loop_args()
@@ -337,6 +338,11 @@ class NumbaBackend(CompiledReads):
                         break
             if not interrupted[0]:
                 return done
+
+    def _log_rows(self) -> int:
+        """Rows of the loop's log buffer: :data:`LOG_ROWS`, and under gravity room for every disc besides (an
+        event that wakes a pile logs a ``SET`` record for each disc that falls again)."""
+        return LOG_ROWS + (len(self._rec) if self.laws.falls else 0)
 
     def set_disc(self, i: int, vx: float, vy: float, position: tuple[float, float] | None = None) -> None:
         """As :meth:`discsim.engines.event_driven.python.PythonBackend.set_disc`: restart moving disc ``i``'s

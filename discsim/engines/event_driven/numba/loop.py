@@ -75,8 +75,8 @@ from discsim.physics.compiled import (
 from discsim.physics.sources.boundaries import MINUS_X, MINUS_Y, PLUS_X, PLUS_Y
 
 INF = math.inf
-COLLISION, WALL, CROSSING, SEGMENT = (
-    int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT)
+COLLISION, WALL, CROSSING, SEGMENT, SET = (
+    int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT, EventKind.SET)
 )
 # Slots of ``ints``.
 I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS = range(12)
@@ -353,6 +353,9 @@ def run_events(
     logged = 0
     capacity = ev_t.shape[0]
     pops = 0
+    # The log rows one event may write: its own, and under gravity one for every disc it wakes (the backend makes
+    # the buffer that much larger).
+    room = 1 + (rec.shape[0] if gravity else 0)
     why = DONE
     max_queue = ints[I_MAXQ]
     virial = floats[F_VIRIAL]
@@ -364,7 +367,7 @@ def run_events(
     have_now = False
     last_time, last_kind, last_i, last_j = floats[F_LTIME], ints[I_LKIND], ints[I_LI], ints[I_LJ]
     while done != limit:
-        if pops == budget or (recording and logged == capacity):
+        if pops == budget or (recording and logged + room > capacity):
             why = MORE
             break
         # Pop the earliest event if it is due.
@@ -512,6 +515,17 @@ def run_events(
                     d = found[m]
                     rec[d, T] = t  # at rest: its record holds where it is, now
                     count[d] += 1
+                    if recording:  # a SET record: it falls from here (trajectories, the viewer and replays know)
+                        ev_t[logged] = t + epoch
+                        ev_kind[logged] = SET
+                        ev_i[logged] = order[d]
+                        ev_j[logged] = -1
+                        ev_f[logged, 0], ev_f[logged, 1] = rec[d, X], rec[d, Y]
+                        ev_f[logged, 2] = ev_f[logged, 3] = 0.0
+                        ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
+                        if rough:
+                            ev_w[logged, 0], ev_w[logged, 1] = rot[d, W], np.nan
+                        logged += 1
                     predict(
                         d, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                         nx, ny, periodic, edges,

@@ -216,7 +216,9 @@ class FramePolicy(Policy):
             w0 = w = float(spins[i])
             ux, uy = vx, vy
             for axis in (0, 1):
-                if hits[axis]:
+                u = ux if axis == 0 else uy
+                if hits[axis] and ((u < 0.0) if lows[axis] else (u > 0.0)):  # still outwards: a rough bounce off
+                    # the other wall (a corner) may have turned it away already
                     ux, uy, w = wall_bounce(ux, uy, axis, lows[axis], e, w, r, m, inertia, beta)
             vel[i] = (ux, uy)
             if e != 1.0 or rough:

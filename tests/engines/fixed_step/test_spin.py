@@ -103,6 +103,19 @@ def test_a_rough_disc_bounces_off_a_wall_a_segment_and_an_obstacle_as_off_an_inf
     assert sim.velocities[1].tolist() == [0.0, 0.0] and sim.spins[1] == 2.0
 
 
+@pytest.mark.parametrize("policy", FRAME_POLICIES)
+def test_a_rough_disc_in_a_corner_is_not_sent_back_into_the_floor(policy):
+    # At the frame (t = 0.6) the disc is past the left wall and the floor, both approached. The left wall's rough
+    # bounce comes first: n = (-1, 0), g_t = 0.1 + r w = 2.1, J = -2 * 2.1 / 3 = -1.4: it leaves at (1, 1.3), spin
+    # -0.8, already moving away from the floor, which must not reflect it back down.
+    disc = ds.Discs([[1.5, 1.05]], [[-1.0, -0.1]], radii=1.0, spins=[2.0])
+    sim = ds.FixedStep(disc, ds.Box(10.0, 10.0), dt=0.6, roughness=1.0, policy=policy).run(frames=1)
+    assert sim.counts["wall_hits"] == 1
+    assert sim.velocities[0] == pytest.approx([1.0, 1.3], rel=1e-14)
+    assert sim.spins[0] == pytest.approx(-0.8, rel=1e-14)
+    assert sim.kinetic_energy() == pytest.approx(0.5 * 1.01 + 0.25 * 4.0, rel=1e-14)
+
+
 # --- energy along a run ------------------------------------------------------------------------------------
 def gas(n=40, packing=0.2, seed=4, periodic=True):
     discs, box = ds.random_gas(n, packing, periodic=periodic, seed=seed)

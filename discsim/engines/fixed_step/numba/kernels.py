@@ -155,22 +155,23 @@ def _walls(
     for i in range(len(pos)):
         r = radii[i]
         hit = False
-        wx = wy = 0.0
+        wx, wy = vel[i, 0], vel[i, 1]
         e = 1.0
         w0 = w = spins[i]
         for axis in range(2):
             size = width if axis == 0 else height
-            p, v = pos[i, axis], vel[i, axis]
+            p, v = pos[i, axis], (wx if axis == 0 else wy)  # walls_crossed: the velocity at the frame
             low = p < r and v < 0.0
             high = p > size - r and v > 0.0
             if low or high:
                 if not hit:
-                    wx, wy = vel[i, 0], vel[i, 1]
                     e = _restitution(i, i, t, e0, per_group, table, group, tc, last)
                 hit = True
-                vel[i, 0], vel[i, 1], w = _wall_bounce(
-                    vel[i, 0], vel[i, 1], axis, low, e, w, r, masses[i], inertia[i], beta
-                )
+                u = vel[i, axis]
+                if (u < 0.0) if low else (u > 0.0):  # still outwards (a rough bounce off the other wall may turn it)
+                    vel[i, 0], vel[i, 1], w = _wall_bounce(
+                        vel[i, 0], vel[i, 1], axis, low, e, w, r, masses[i], inertia[i], beta
+                    )
                 if policy == SEPARATE:
                     pos[i, axis] = r if low else size - r
         if not hit:

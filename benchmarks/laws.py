@@ -12,6 +12,7 @@ each law in turn (so a slow spell hits them alike), ``--repeats`` times (default
   granular gas.
 * ``gravity+restitution``: both (the gas settles while it is timed).
 * ``rough``: no gravity, elastic, ``roughness=0.5``: rough discs that spin (they start without spin).
+* ``perfectly rough``: the same at ``roughness=1`` (energy conserved: the spins take their share and keep it).
 
 Under any law but the first the pure-Python backend runs the compiled loop's source interpreted (its own loop
 knows free flight only). The issue's target: the compiled backend within 1.5x of its elastic rate under gravity
@@ -28,7 +29,7 @@ from benchutils import Column, call_fresh, format_table, machine_summary, median
 
 import discsim as ds
 
-LAWS = ("elastic", "gravity", "restitution", "gravity+restitution", "rough")
+LAWS = ("elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough")
 KEYS = ["backend", "law", "n", "events", "collisions_per_s", "ratio_to_elastic", "repeats"]
 COLUMNS = [
     Column("backend", "backend", "s"),
@@ -53,6 +54,8 @@ def keywords(law: str, discs, box) -> dict:
         out.update(restitution=0.9, tc=free_time / 100.0)
     if law == "rough":
         out["roughness"] = 0.5
+    if law == "perfectly rough":
+        out["roughness"] = 1.0
     return out
 
 

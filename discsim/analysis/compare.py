@@ -22,7 +22,7 @@ import numpy as np
 from discsim.cells import neighbour_pairs
 from discsim.errors import InvalidArgumentError, WrongTypeError
 from discsim.events import COLLISION, WALL
-from discsim.model import frame_count, kinetic_energy
+from discsim.model import frame_count, kinetic_energy, rotational_energy
 from discsim.trajectory import check_times
 
 __all__ = ["Comparison", "compare"]
@@ -379,7 +379,7 @@ def _energy_error(engine) -> float:
     discs = engine.discs
     gx, gy = _gravity(engine)
     finite = np.isfinite(discs.masses)
-    e0 = kinetic_energy(discs.velocities, discs.masses)
+    e0 = kinetic_energy(discs.velocities, discs.masses) + rotational_energy(discs.spins, discs.inertia)
     e0 -= float(np.sum(discs.masses[finite] * (discs.positions[finite] @ np.array([gx, gy]))))
     energy = getattr(engine, "energy", engine.kinetic_energy)
     e1 = float(energy()) + float(getattr(engine, "dissipated", 0.0))
@@ -404,7 +404,9 @@ def _rebound(record, gravity: tuple[float, float]) -> float:
 
 
 def _energy_change(engine) -> float:
-    e0 = kinetic_energy(engine.discs.velocities, engine.discs.masses)
+    """Relative change of ``kinetic_energy()`` from the start (the rotational energy of spinning discs included)."""
+    discs = engine.discs
+    e0 = kinetic_energy(discs.velocities, discs.masses) + rotational_energy(discs.spins, discs.inertia)
     e1 = engine.kinetic_energy()
     return (e1 - e0) / e0 if e0 > 0 else 0.0
 
@@ -460,7 +462,7 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
 
     Raises:
         ValueError: if the runs do not start from the same state (naming the
-            first differing disc and its two positions), have different boxes
+            first differing disc and its two positions, velocities, spins ...), have different boxes
             or numbers of discs, or ``window`` is negative.
 
     Example:
@@ -496,7 +498,7 @@ def compare(truth, approx, *, window: float | None = None, times=None, until: fl
     if truth.box != approx.box:
         msg = f"the runs have different boxes: truth {truth.box}, approx {approx.box}"
         raise InvalidArgumentError(msg)
-    for what in ("positions", "velocities", "radii", "masses"):
+    for what in ("positions", "velocities", "radii", "masses", "spins", "inertia"):
         a, b = getattr(truth.discs, what), getattr(approx.discs, what)
         differs = ~((a == b) | np.isclose(a, b, rtol=1e-12, atol=0.0))
         if differs.any():

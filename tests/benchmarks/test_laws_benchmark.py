@@ -19,7 +19,8 @@ def test_quick_mode_writes_a_row_per_backend_and_law(tmp_path):
         assert module.main(["--quick", "--results", str(tmp_path)]) == 0
     with open(tmp_path / "laws.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
-    assert {row["law"] for row in rows} == {"elastic", "gravity", "restitution", "gravity+restitution", "rough"}
+    laws = {"elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough"}
+    assert {row["law"] for row in rows} == laws
     for row in rows:
         assert float(row["collisions_per_s"]) > 0
         if row["law"] == "elastic":

@@ -38,6 +38,8 @@ class Shapes:
         e (float), per_group (bool), e_table (G lists of G floats), e_group (list of N ints), tc (float): the
             arguments of :func:`~discsim.engines.fixed_step.parts.restitution` (``e_group`` indexes
             ``e_table`` by the rank of each disc's group label).
+        beta (float): the roughness (-1: smooth); rough (bool): ``beta`` above -1, the responses turn the discs.
+        inertia ``(N,)`` float array and inertias (list of N floats): the moments of inertia (inf: cannot turn).
     """
 
     def __init__(self, scene: Scene, laws: Laws | None = None):
@@ -65,6 +67,9 @@ class Shapes:
         labels = np.unique(discs.groups)
         self.e_table = laws.table(labels).tolist()
         self.e_group = np.searchsorted(labels, discs.groups).tolist()
+        self.beta, self.rough = laws.roughness, laws.rough
+        self.inertia = np.array(discs.inertia)
+        self.inertias = discs.inertia.tolist()
 
 
 class Paths:
@@ -85,11 +90,14 @@ class Paths:
         frame_positions ``(N, 2)``: the positions at the last frame, wrapped into a periodic box.
         last_collision ``(N,)``: each disc's last response time (``-inf``: none; kept for the TC model only).
         gravity: ``(gx, gy)``; falls ``(N,)`` bool: the discs it moves (None: no gravity).
+        spins ``(N,)``: the angular velocities (radians per time, counter-clockwise); changed only by the
+            responses of rough discs. angles ``(N,)``: each disc's angle at its time in ``angle_times``
+            ``(N,)`` (:meth:`turning` gives them all at one time).
     """
 
     def __init__(
         self, box, ref_positions, ref_times, velocities, images, frame_positions, last_collision=None,
-        gravity=(0.0, 0.0), falls=None,
+        gravity=(0.0, 0.0), falls=None, spins=None, angles=None, angle_time=0.0,
     ):  # fmt: skip
         self.box = box
         self.ref_positions = ref_positions
@@ -100,6 +108,19 @@ class Paths:
         self.last_collision = np.full(len(ref_times), -np.inf) if last_collision is None else last_collision
         self.gravity = (float(gravity[0]), float(gravity[1]))
         self.falls = falls if falls is not None and gravity != (0.0, 0.0) and falls.any() else None
+        n = len(ref_times)
+        self.spins = np.zeros(n) if spins is None else spins
+        self.angles = np.zeros(n) if angles is None else angles
+        self.angle_times = np.full(n, float(angle_time))
+
+    def turning(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """``(spins, angles)`` at time ``t``, ``(N,)`` each (new arrays)."""
+        return self.spins.copy(), self.angles + self.spins * (t - self.angle_times)
+
+    def spin_to(self, disc: int, t: float) -> None:
+        """Bring disc ``disc``'s angle to time ``t`` (before its spin changes there)."""
+        self.angles[disc] += self.spins[disc] * (t - self.angle_times[disc])
+        self.angle_times[disc] = t
 
     def flown(self, t: float) -> np.ndarray:
         """``(N, 2)`` positions at time ``t`` on the current paths, not wrapped."""

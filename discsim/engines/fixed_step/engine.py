@@ -12,9 +12,10 @@ answers with one of five policies, chosen once when the engine is built:
 Between responses discs fly straight, so the event log (one record per response, with the state just
 after it) rebuilds the exact path the engine took, and ``trajectory()`` works as for the event-driven
 engine. The laws of :class:`~discsim.engines.event_driven.EventDriven` apply too (``gravity=``,
-``restitution=``, ``tc=``): under gravity every disc of finite mass follows the exact parabola over a frame
-(:func:`~discsim.physics.dynamics.advance`; ``trajectory()`` adds the fall since each disc's last record),
-and the responses apply the restitution through the same collision law (:mod:`discsim.physics.laws`).
+``restitution=``, ``tc=``, ``roughness=``): under gravity every disc of finite mass follows the exact parabola over a
+frame (:func:`~discsim.physics.dynamics.advance`; ``trajectory()`` adds the fall since each disc's last record),
+and the responses apply the restitution, and the roughness that turns the discs (``spins``, ``angles``), through the
+same collision law (:mod:`discsim.physics.laws`).
 The broad phase (:mod:`~discsim.engines.fixed_step.broad_phase`) is a Verlet list on a cell grid or every
 pair; both give identical runs. Collision filtering (``pass_through``) drops the pairs of groups that pass
 through each other before the narrow phase, under every policy.
@@ -31,7 +32,6 @@ state, so a run saved under one continues under the other.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -109,6 +109,11 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             over a frame (``x += v dt + g dt^2 / 2``, ``v += g dt``; the frame policies only: ``"bisect"`` and
             ``"swept"`` follow straight paths inside a frame and refuse it); ``e`` in [0, 1] (or per pair of
             groups) at every response, the energy taken in :attr:`dissipated`; the TC time (0: none).
+        roughness: the tangential restitution ``beta`` in [-1, 1] of every response, as for ``EventDriven``:
+            -1 (the default) smooth, today's frames bit for bit; above -1 each response adds the tangential
+            impulse at the contact point (:func:`~discsim.physics.laws.rough_impulse`, arms the radii; walls and
+            segments as rough as the discs) that turns the discs (``discs.spins``, ``discs.inertia``;
+            :attr:`spins`, :attr:`angles`), every policy alike; the energy taken in :attr:`dissipated`.
         rest_speed: checked as ``EventDriven`` checks it, and ignored: PIT has no rest (a disc on a floor
             keeps bouncing from frame to frame).
 
@@ -183,6 +188,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         restitution=1.0,
         tc: float = 0.0,
         rest_speed: float | None = None,
+        roughness: float = -1.0,
     ):
         if dt is None:
             rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
@@ -202,7 +208,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
-        laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed), policy)
+        laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness), policy)
         backend = _choose_backend(backend, policy)
         scene = Scene(discs, box, segments, pass_through)
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws)
@@ -245,22 +251,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         positions are where they are added), on the frame grid as before; the Verlet list is rebuilt at the
         next frame."""
         parts = self._parts(scene)  # may refuse the new discs: nothing changed
-        state = self.state()
-        arrays = {n: getattr(state, n)[keep] for n in ("ref_positions", "velocities", "ref_times", "last_collision")}
-        arrays.update(images=state.images[keep], frame_positions=state.frame_positions[keep])
-        if added is not None:
-            k, t = len(added), self.time
-            for name, rows in (
-                ("ref_positions", added.positions),
-                ("velocities", added.velocities),
-                ("ref_times", np.full(k, t)),
-                ("last_collision", np.full(k, -np.inf)),
-                ("images", np.zeros((k, 2), dtype=np.int64)),
-                ("frame_positions", added.positions),
-            ):
-                arrays[name] = np.concatenate([arrays[name], rows])
-        empty = np.zeros(0, dtype=np.int64)
-        state = dataclasses.replace(state, **arrays, list_positions=np.zeros((0, 2)), list_i=empty, list_j=empty)
+        state = self._kept_state(keep, added)
         self._shapes, self._broad, self._policy = parts
         self.scene, self.discs = scene, scene.discs
         self._load(state)

@@ -10,6 +10,8 @@ changes the velocities the next one sees. The three policies differ in where the
   line of centres at the frame (if approaching); a disc past a wall and moving outwards has its normal
   velocity reversed; a disc cutting a segment and approaching it is reflected off it
   (:func:`~discsim.kernels.reflect_off_segment`, the normal from the segment's nearest point to the centre).
+  Rough discs (``roughness`` above -1) get the tangential impulse at the contact point too, and turn
+  (:func:`~discsim.engines.fixed_step.parts.rough_pair`, ``wall_bounce``, ``segment_bounce``).
 - ``"revert"`` (:class:`Revert`): back where they were at the previous frame; a pair's impulse is along
   the line of centres there (if the pair approaches along it).
 - ``"separate"`` (:class:`Separate`): pushed apart along the line of centres until they just touch (each
@@ -28,11 +30,20 @@ import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import BroadPhase
-from discsim.engines.fixed_step.parts import impulse_virial, kinetic_loss, push_off_segment, restitution, separate_pair
+from discsim.engines.fixed_step.parts import (
+    impulse_virial,
+    kinetic_loss,
+    push_off_segment,
+    restitution,
+    rough_pair,
+    segment_bounce,
+    separate_pair,
+    spin_loss,
+    wall_bounce,
+)
 from discsim.events import Event
-from discsim.kernels import closest_point_on_segment, reflect_off_segment, resolve_collision
+from discsim.kernels import closest_point_on_segment, resolve_collision
 from discsim.model import minimum_image_1d
-from discsim.physics.laws import reflect
 
 __all__ = [
     "FRAME_POLICY_CLASSES",
@@ -127,26 +138,27 @@ class FramePolicy(Policy):
         """Where discs ``rows`` found past a wall (``low``, ``high``: see :func:`walls_crossed`) are left."""
         return pos
 
-    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0):
+    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0)):
         """Answer one disc at ``(x, y)`` moving at ``(vx, vy)`` that cuts segments ``hits`` (end point tuples).
 
         The segments are visited in order, each seeing the position and velocity the one before left
         (a disc in a corner may touch two). ``previous``: the disc's ``(2,)`` position at the previous frame;
-        ``e``: the restitution of its bounces.
+        ``e``: the restitution of its bounces; ``turn``: ``(spin, mass, inertia, roughness)`` (smooth: -1).
 
         Returns:
-            ``(x, y, vx, vy, responded)``.
+            ``(x, y, vx, vy, spin, responded)``.
         """
         responded = False
+        w, m, inertia, beta = turn
         for ends in hits:
             qx, qy = closest_point_on_segment(x, y, *ends)
             nx, ny = x - qx, y - qy
             if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
             x, y = self.off_segment(x, y, qx, qy, nx, ny, r)
-            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e=e)
+            vx, vy, w = segment_bounce(x, y, vx, vy, *ends, e, w, r, m, inertia, beta)
             responded = True
-        return x, y, vx, vy, responded
+        return x, y, vx, vy, w, responded
 
     def off_segment(self, x, y, qx, qy, nx, ny, r) -> tuple[float, float]:
         """Where a disc at ``(x, y)`` approaching a segment is left (nearest point ``(qx, qy)``, normal ``n``)."""
@@ -179,7 +191,7 @@ class FramePolicy(Policy):
         if not hit.any():
             return pos
         rows = np.flatnonzero(hit.any(axis=1))
-        self._reflect_off_walls(t, rows, hit, paths, tally)
+        self._reflect_off_walls(t, rows, hit, low, paths, tally)
         pos = self.off_walls(pos, prev, rows, low, high, self.shapes.radii[:, None], size)
         paths.restart(rows, pos[rows], t)  # a walled box: no images
         tally.counts["wall_hits"] += len(rows)
@@ -190,18 +202,30 @@ class FramePolicy(Policy):
                 log.wall(t, i, *pos[i].tolist(), *vel[i].tolist())
         return pos
 
-    def _reflect_off_walls(self, t, rows, hit, paths, tally) -> None:
-        """Reverse the normal velocity of discs ``rows`` along each axis ``hit`` ``(N, 2)``, with restitution."""
-        shapes, vel, last = self.shapes, paths.velocities, paths.last_collision
+    def _reflect_off_walls(self, t, rows, hit, low, paths, tally) -> None:
+        """Reverse the normal velocity of discs ``rows`` along each axis ``hit`` ``(N, 2)`` (on the ``low`` side
+        ``(N, 2)`` or the high one), with restitution and roughness."""
+        shapes, vel, last, spins = self.shapes, paths.velocities, paths.last_collision, paths.spins
         e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
-        for i, (vx, vy), (hit_x, hit_y) in zip(rows.tolist(), vel[rows].tolist(), hit[rows].tolist()):
+        rough, beta = shapes.rough, shapes.beta
+        for i, (vx, vy), hits, lows in zip(rows.tolist(), vel[rows].tolist(), hit[rows].tolist(), low[rows].tolist()):
             e = restitution(i, i, t, e0, per_group, table, group, tc, last)
-            ux, uy = reflect(vx, vy, 0, e) if hit_x else (vx, vy)
-            if hit_y:
-                ux, uy = reflect(ux, uy, 1, e)
+            m, inertia, r = shapes.masses[i], shapes.inertias[i], shapes.radius[i]
+            if rough:
+                paths.spin_to(i, t)
+            w0 = w = float(spins[i])
+            ux, uy = vx, vy
+            for axis in (0, 1):
+                u = ux if axis == 0 else uy
+                if hits[axis] and ((u < 0.0) if lows[axis] else (u > 0.0)):  # still outwards: a rough bounce off
+                    # the other wall (a corner) may have turned it away already
+                    ux, uy, w = wall_bounce(ux, uy, axis, lows[axis], e, w, r, m, inertia, beta)
             vel[i] = (ux, uy)
-            if e != 1.0:
-                tally.dissipated += kinetic_loss(shapes.masses[i], vx, vy, ux, uy)
+            if e != 1.0 or rough:
+                tally.dissipated += kinetic_loss(m, vx, vy, ux, uy)
+            if rough:
+                spins[i] = w
+                tally.dissipated += spin_loss(inertia, w0, w)
             if tc > 0.0:
                 last[i] = t
 
@@ -211,9 +235,10 @@ class FramePolicy(Policy):
         if not len(rows):
             return
         shapes = self.shapes
-        vel, last = paths.velocities, paths.last_collision
+        vel, last, spins = paths.velocities, paths.last_collision, paths.spins
         radius, ends = shapes.radius, shapes.seg_ends
         e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
+        rough, beta = shapes.rough, shapes.beta
         log = tally.log
         by_disc: dict[int, list[tuple]] = {}
         for i, k in zip(rows.tolist(), cols.tolist()):
@@ -222,10 +247,16 @@ class FramePolicy(Policy):
             x, y = pos[i].tolist()
             wx, wy = vel[i].tolist()
             e = restitution(i, i, t, e0, per_group, table, group, tc, last)
-            x, y, vx, vy, responded = self.off_segments(x, y, wx, wy, prev[i], hits, radius[i], e)
+            w0 = float(spins[i])
+            turn = (w0, shapes.masses[i], shapes.inertias[i], beta)
+            x, y, vx, vy, w, responded = self.off_segments(x, y, wx, wy, prev[i], hits, radius[i], e, turn)
             if responded:
-                if e != 1.0:
+                if e != 1.0 or rough:
                     tally.dissipated += kinetic_loss(shapes.masses[i], wx, wy, vx, vy)
+                if rough:
+                    paths.spin_to(i, t)
+                    spins[i] = w
+                    tally.dissipated += spin_loss(shapes.inertias[i], w0, w)
                 if tc > 0.0:
                     last[i] = t
                 pos[i] = (x, y)
@@ -268,8 +299,9 @@ class FramePolicy(Policy):
         mass, radius = shapes.masses, shapes.radius
         box = shapes.box
         periodic, width, height = box.periodic, box.width, box.height
-        vel, last = paths.velocities, paths.last_collision
+        vel, last, spins, inertia = paths.velocities, paths.last_collision, paths.spins, shapes.inertias
         e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
+        rough, beta = shapes.rough, shapes.beta
         log = tally.log
         involved = np.unique(np.concatenate([ii, jj]))
         keys = involved.tolist()
@@ -296,7 +328,17 @@ class FramePolicy(Policy):
             xi, yi, xj, yj, dx, dy = self.contact(xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, before_i, before_j)
             e = restitution(i, j, t, e0, per_group, table, group, tc, last)
             uxi, uyi, uxj, uyj = resolve_collision(dx, dy, vxi, vyi, vxj, vyj, mi, mj, e)
-            if e != 1.0:
+            if rough:  # the tangential impulse at the contact point turns both
+                paths.spin_to(i, t)
+                paths.spin_to(j, t)
+                wi, wj = float(spins[i]), float(spins[j])
+                uxi, uyi, uxj, uyj, spins[i], spins[j] = rough_pair(
+                    dx, dy, vxi, vyi, vxj, vyj, uxi, uyi, uxj, uyj, wi, wj, radius[i], radius[j], mi, mj,
+                    inertia[i], inertia[j], beta,
+                )  # fmt: skip
+                tally.dissipated += spin_loss(inertia[i], wi, float(spins[i]))
+                tally.dissipated += spin_loss(inertia[j], wj, float(spins[j]))
+            if e != 1.0 or rough:
                 tally.dissipated += kinetic_loss(mi, vxi, vyi, uxi, uyi) + kinetic_loss(mj, vxj, vyj, uxj, uyj)
             if tc > 0.0:  # the TC model's clocks (an obstacle keeps none, as in EventDriven)
                 if shapes.moving[i]:
@@ -340,9 +382,10 @@ class Revert(FramePolicy):
         pos[rows] = prev[rows]
         return pos
 
-    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0):
+    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0)):
         reverted = False
         responded = False
+        w, m, inertia, beta = turn
         for ends in hits:
             qx, qy = closest_point_on_segment(x, y, *ends)
             nx, ny = x - qx, y - qy
@@ -356,14 +399,14 @@ class Revert(FramePolicy):
                     fx, fy = x, y
                     x, y = px, py
                     reverted = True
-                    vx, vy = reflect_off_segment(fx, fy, vx, vy, *ends, e=e)
+                    vx, vy, w = segment_bounce(fx, fy, vx, vy, *ends, e, w, r, m, inertia, beta)
                     responded = True
                     continue
             if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
-            vx, vy = reflect_off_segment(x, y, vx, vy, *ends, e=e)
+            vx, vy, w = segment_bounce(x, y, vx, vy, *ends, e, w, r, m, inertia, beta)
             responded = True
-        return x, y, vx, vy, responded
+        return x, y, vx, vy, w, responded
 
     def contact(self, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, before_i, before_j):
         xi, yi = before_i

@@ -15,7 +15,10 @@ very source (``discsim._compiled.compile_from_source``), so the two cannot drift
 - :func:`table_shape` and :func:`cell_span`: the cells of the sub-frame policies' cell table
   (:class:`~discsim.engines.fixed_step.broad_phase.CellTable`) and the cells a box meets;
 - :func:`restitution` and :func:`kinetic_loss`: the coefficient of restitution of one response (one number,
-  or the pair of groups', 1 within the TC time) and the kinetic energy it takes from one disc.
+  or the pair of groups', 1 within the TC time) and the kinetic energy it takes from one disc;
+- :func:`wall_bounce`, :func:`segment_bounce` and :func:`rough_pair`: a response with roughness (the collision
+  law's :func:`~discsim.physics.laws.rough_impulse` after its normal impulse, as the event-driven loop applies
+  it), :func:`spin_loss` the rotational energy it takes from one disc.
 
 The free flight, the collision law and the times of impact are the physics parts themselves
 (:mod:`discsim.physics.dynamics`, :mod:`discsim.physics.laws`, :mod:`discsim.physics.sources`).
@@ -26,6 +29,7 @@ from __future__ import annotations
 import math
 
 from discsim.model import minimum_image_1d
+from discsim.physics.laws import closest_point_on_segment, reflect, reflect_off_segment, rough_impulse
 
 __all__ = [
     "box_image",
@@ -35,8 +39,12 @@ __all__ = [
     "nearest_image",
     "push_off_segment",
     "restitution",
+    "rough_pair",
+    "segment_bounce",
     "separate_pair",
+    "spin_loss",
     "table_shape",
+    "wall_bounce",
     "wrap",
 ]
 
@@ -229,3 +237,93 @@ def kinetic_loss(m: float, vx: float, vy: float, ux: float, uy: float) -> float:
     if m == INF:
         return 0.0
     return 0.5 * m * ((vx * vx + vy * vy) - (ux * ux + uy * uy))
+
+
+def spin_loss(inertia: float, w: float, u: float) -> float:
+    """The rotational energy a disc of moment of inertia ``inertia`` loses going from spin ``w`` to ``u`` (0 for a
+    disc that cannot turn, ``inertia`` inf).
+
+    Example:
+        >>> spin_loss(0.5, 2.0, 1.0), spin_loss(math.inf, 0.0, 0.0)
+        (0.75, 0.0)
+    """
+    if inertia == INF:
+        return 0.0
+    return 0.5 * inertia * (w * w - u * u)
+
+
+def rough_pair(
+    dx: float, dy: float, vxi: float, vyi: float, vxj: float, vyj: float, uxi: float, uyi: float, uxj: float,
+    uyj: float, wi: float, wj: float, ri: float, rj: float, mi: float, mj: float, ii: float, ij: float, beta: float,
+) -> tuple[float, float, float, float, float, float]:  # fmt: skip
+    """A pair response with roughness ``beta``: velocities ``u`` after the normal impulse (from ``v``, along the line
+    of centres ``(dx, dy)``, ``j - i``), then the tangential impulse of
+    :func:`~discsim.physics.laws.rough_impulse` at the contact point (arms ``ri``, ``rj``: the radii), as the
+    event-driven loop adds it.
+
+    Returns:
+        ``(uxi, uyi, uxj, uyj, wi, wj)``: the velocities and spins after.
+
+    Example:
+        >>> rough_pair(2.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.0, 1.0, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0)
+        (0.0, -1.0, 1.0, 1.0, -2.0, 1.0)
+    """
+    txi, tyi, txj, tyj, wi, wj = rough_impulse(dx, dy, vxi, vyi, vxj, vyj, wi, wj, ri, rj, mi, mj, ii, ij, beta)
+    return uxi + (txi - vxi), uyi + (tyi - vyi), uxj + (txj - vxj), uyj + (tyj - vyj), wi, wj
+
+
+def _rough_bounce(
+    cx: float, cy: float, vx: float, vy: float, ux: float, uy: float, w: float, r: float, m: float, inertia: float,
+    beta: float,
+) -> tuple[float, float, float]:  # fmt: skip
+    """A bounce's tangential impulse (roughness ``beta``) against an infinite mass that does not turn, the contact
+    point towards ``(cx, cy)`` from the centre, ``r`` away; ``v`` the velocity before the normal bounce, ``u``
+    after. Returns ``(ux, uy, w)`` after both."""
+    tx, ty, _, _, w, _ = rough_impulse(cx, cy, vx, vy, 0.0, 0.0, w, 0.0, r, 0.0, m, INF, inertia, INF, beta)
+    return ux + (tx - vx), uy + (ty - vy), w
+
+
+def wall_bounce(
+    vx: float, vy: float, axis: int, low: bool, e: float, w: float, r: float, m: float, inertia: float, beta: float
+) -> tuple[float, float, float]:
+    """A bounce off the wall ``axis`` (0: at x = const) on the ``low`` side (at 0) or the high one:
+    :func:`~discsim.physics.laws.reflect` with restitution ``e``, then, for rough discs (``beta`` above -1), the
+    tangential impulse at the contact point (the wall as rough as the discs, as in the event-driven engine).
+
+    Returns:
+        ``(vx, vy, w)``: the velocity and spin after.
+
+    Example:
+        >>> wall_bounce(1.0, -1.0, 1, True, 1.0, 0.0, 1.0, 1.0, 0.5, 1.0)  # onto the floor at 45 degrees
+        (0.33333333333333337, 1.0, -1.3333333333333333)
+    """
+    ux, uy = reflect(vx, vy, axis, e)
+    if beta != -1.0:
+        c = -1.0 if low else 1.0
+        if axis == 0:
+            ux, uy, w = _rough_bounce(c, 0.0, vx, vy, ux, uy, w, r, m, inertia, beta)
+        else:
+            ux, uy, w = _rough_bounce(0.0, c, vx, vy, ux, uy, w, r, m, inertia, beta)
+    return ux, uy, w
+
+
+def segment_bounce(
+    x: float, y: float, vx: float, vy: float, ax: float, ay: float, bx: float, by: float, e: float, w: float,
+    r: float, m: float, inertia: float, beta: float,
+) -> tuple[float, float, float]:  # fmt: skip
+    """A bounce of a disc at ``(x, y)`` off segment ``a``-``b``: :func:`~discsim.physics.laws.reflect_off_segment`
+    with restitution ``e``, then, for rough discs (``beta`` above -1), the tangential impulse at the contact point
+    (towards the segment's nearest point).
+
+    Returns:
+        ``(vx, vy, w)``: the velocity and spin after.
+
+    Example:
+        >>> segment_bounce(0.0, 0.5, 1.0, -1.0, -3.0, 0.0, 3.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.5, 1.0)
+        (0.33333333333333337, 1.0, -1.3333333333333333)
+    """
+    ux, uy = reflect_off_segment(x, y, vx, vy, ax, ay, bx, by, e)
+    if beta != -1.0:
+        qx, qy = closest_point_on_segment(x, y, ax, ay, bx, by)
+        ux, uy, w = _rough_bounce(qx - x, qy - y, vx, vy, ux, uy, w, r, m, inertia, beta)
+    return ux, uy, w

@@ -1,5 +1,5 @@
-"""What a fixed-step run shows: positions and velocities at any time, the counters, the pressure, the energies,
-the trajectory under gravity, the frame clock.
+"""What a fixed-step run shows: positions and velocities at any time, spins and angles, the counters, the pressure,
+the energies, the trajectory under gravity, the frame clock.
 
 :class:`FrameReadout` is the read-only side of :class:`~discsim.engines.fixed_step.engine.FixedStep`: it reads
 the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and changes nothing.
@@ -15,7 +15,7 @@ import numpy as np
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.errors import InvalidArgumentError
 from discsim.laws import Laws
-from discsim.model import Box, Discs, _readonly
+from discsim.model import Box, Discs, _readonly, kinetic_energy, rotational_energy
 
 __all__ = ["FrameReadout"]
 
@@ -39,8 +39,6 @@ class FrameReadout:
     run_context: Any
 
     if TYPE_CHECKING:
-
-        def kinetic_energy(self) -> float: ...  # Engine's
 
         @property
         def events(self) -> np.ndarray: ...  # EventRecord's
@@ -92,8 +90,32 @@ class FrameReadout:
         return _readonly(self._paths.velocities.copy())
 
     @property
+    def spins(self) -> np.ndarray:
+        """``(N,)`` angular velocities at ``time`` (radians per time unit, counter-clockwise positive; a fresh
+        read-only copy). Changed only by the responses of rough discs (``roughness``)."""
+        return _readonly(self._paths.spins.copy())
+
+    @property
+    def angles(self) -> np.ndarray:
+        """``(N,)`` each disc's angle at ``time`` (radians, counter-clockwise, 0 at the start; not wrapped; a fresh
+        read-only copy)."""
+        return _readonly(self._paths.turning(self.time)[1])
+
+    def kinetic_energy(self) -> float:
+        """Total kinetic energy: translation ``sum(m |v|^2) / 2`` plus rotation ``sum(I w^2) / 2`` (over discs of
+        finite mass and inertia; the rotational part is zero unless discs spin)."""
+        spinning = rotational_energy(self._paths.spins, self.discs.inertia)
+        return kinetic_energy(self.velocities, self.discs.masses) + spinning
+
+    def snapshot(self) -> Discs:
+        """The discs as they are now: a new :class:`~discsim.model.Discs` at ``time``, spins included."""
+        d = self.discs
+        return Discs(self.positions, self.velocities, d.radii, d.masses, d.groups, self.spins, d.inertia)
+
+    @property
     def dissipated(self) -> float:
-        """Kinetic energy taken since the start by the responses with restitution below 1 (0 for elastic discs).
+        """Kinetic energy taken since the start by the responses with restitution below 1 or roughness strictly
+        between -1 and 1, the rotational energy included (0 for elastic, smooth discs).
 
         Only the collision law's loss: what the frames' own errors add or take (a disc that sinks into the
         floor before its bounce, ``"separate"`` lifting it out, ``"revert"`` sending it back) is not counted,

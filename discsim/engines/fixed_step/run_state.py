@@ -8,6 +8,7 @@ working parts (the paths, the tally, the broad phase's Verlet list, the frame cl
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -55,11 +56,14 @@ class FixedStepRun:
             list_i=empty,
             list_j=empty,
             last_collision=np.full(n, -np.inf),
+            spins=np.array(discs.spins),
+            angles=np.zeros(n),
         )
 
     def state(self) -> FixedStepState:
         """The run state (:class:`~discsim.engines.fixed_step.state.FixedStepState`): new arrays."""
         paths, counts = self._paths, self._tally.counts
+        spins, angles = paths.turning(float(self.time))
         list_positions, list_i, list_j = self._broad.export()
         return FixedStepState(
             time=float(self.time),
@@ -83,6 +87,8 @@ class FixedStepRun:
             list_j=list_j,
             dissipated=float(self._tally.dissipated),
             last_collision=paths.last_collision.copy(),
+            spins=spins,
+            angles=angles,
         )
 
     def _load(self, state: FixedStepState) -> None:
@@ -96,6 +102,8 @@ class FixedStepRun:
             ("images", np.int64, (n, 2)),
             ("frame_positions", np.float64, (n, 2)),
             ("last_collision", np.float64, (n,)),
+            ("spins", np.float64, (n,)),
+            ("angles", np.float64, (n,)),
         ):
             array = np.array(getattr(state, name), dtype=dtype)
             if array.shape != shape:
@@ -103,9 +111,34 @@ class FixedStepRun:
                 raise CheckpointError(msg)
             arrays[name] = array
         shapes = self._shapes
-        self._paths = Paths(self.box, **arrays, gravity=shapes.gravity, falls=shapes.falls)
+        self._paths = Paths(
+            self.box, **arrays, gravity=shapes.gravity, falls=shapes.falls, angle_time=float(state.time)
+        )
         self._tally = Tally(state.counts, state.max_overlap, state.virial, state.dissipated)
         built = state.list_builds > 0 and len(state.list_positions) == n  # not after add_discs / remove_discs
         self._broad.load(state.list_positions, state.list_i, state.list_j, built=built)
         self._frame_time = float(state.frame_time)
         self.time = float(state.time)
+
+    def _kept_state(self, keep: np.ndarray, added: Discs | None) -> FixedStepState:
+        """The state of discs ``keep`` and then ``added`` (new at ``time``, where they are added, with their own
+        spins), for ``add_discs`` and ``remove_discs``: the Verlet list dropped (rebuilt at the next frame)."""
+        state = self.state()
+        names = ("ref_positions", "velocities", "ref_times", "last_collision", "spins", "angles")
+        arrays = {n: getattr(state, n)[keep] for n in names}
+        arrays.update(images=state.images[keep], frame_positions=state.frame_positions[keep])
+        if added is not None:
+            k, t = len(added), self.time
+            for name, rows in (
+                ("ref_positions", added.positions),
+                ("velocities", added.velocities),
+                ("ref_times", np.full(k, t)),
+                ("last_collision", np.full(k, -np.inf)),
+                ("spins", added.spins),
+                ("angles", np.zeros(k)),
+                ("images", np.zeros((k, 2), dtype=np.int64)),
+                ("frame_positions", added.positions),
+            ):
+                arrays[name] = np.concatenate([arrays[name], rows])
+        empty = np.zeros(0, dtype=np.int64)
+        return dataclasses.replace(state, **arrays, list_positions=np.zeros((0, 2)), list_i=empty, list_j=empty)

@@ -18,7 +18,7 @@ __all__ = ["FixedStepState"]
 
 @dataclass(eq=False)
 class FixedStepState(EngineState):
-    """Everything a fixed-step run needs to continue bit for bit (version 3).
+    """Everything a fixed-step run needs to continue bit for bit (version 4).
 
     Per-disc arrays are indexed as ``discs``. Frame ``k`` falls at ``start_time + k / frame_rate`` (or
     ``start_time + k * dt``, as the engine was built), so the frame count fixes the frame times.
@@ -47,13 +47,17 @@ class FixedStepState(EngineState):
             broad phase was last built, or ``(0, 2)`` if it never was (``list_builds == 0``).
         list_i, list_j ``(P,)`` int64: the pairs of discs in that list.
         last_collision ``(N,)``: each disc's last response time (``-inf``: none), for the TC model.
+        spins ``(N,)``: the angular velocities (radians per time, counter-clockwise positive); changed only by
+            the responses of rough discs (``roughness`` above -1).
+        angles ``(N,)``: each disc's angle at ``time`` (radians, counter-clockwise, 0 at the start; not wrapped).
 
     Versions: 1 had no ``virial``; it is read with ``virial = NaN`` (:meth:`from_arrays`), which
     ``FixedStep`` rebuilds from the event log when the log covers the whole run. 1 and 2 had no laws
-    (``dissipated``, ``last_collision``): they are read with their defaults, 0 and ``-inf``.
+    (``dissipated``, ``last_collision``): they are read with their defaults, 0 and ``-inf``. 1 to 3 had no
+    spins (``spins``, ``angles``): they are read with zeros (the discs did not turn).
     """
 
-    VERSION = 3
+    VERSION = 4
 
     time: float
     frame_time: float
@@ -76,15 +80,23 @@ class FixedStepState(EngineState):
     list_j: np.ndarray
     dissipated: float = 0.0
     last_collision: np.ndarray = None  # type: ignore[assignment]  # None: no response yet (filled in below)
+    spins: np.ndarray = None  # type: ignore[assignment]  # None: zeros (filled in below)
+    angles: np.ndarray = None  # type: ignore[assignment]  # None: zeros
 
     def __post_init__(self) -> None:
+        n = len(self.ref_times)
         if self.last_collision is None:
-            self.last_collision = np.full(len(self.ref_times), -np.inf)
+            self.last_collision = np.full(n, -np.inf)
+        if self.spins is None:
+            self.spins = np.zeros(n)
+        if self.angles is None:
+            self.angles = np.zeros(n)
 
     @classmethod
     def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int) -> FixedStepState:
         """As :meth:`EngineState.from_arrays`; a version 1 state (before ``virial``) gets ``virial = NaN``, and a
-        version 1 or 2 state (before the laws) ``dissipated = 0`` and no last responses."""
+        version 1 or 2 state (before the laws) ``dissipated = 0`` and no last responses, and a version 1 to 3 state
+        (before the spins) spins and angles zero."""
         if version == 1 and "virial" not in scalars:
             scalars = {**scalars, "virial": math.nan}
             version = 2
@@ -92,6 +104,10 @@ class FixedStepState(EngineState):
             n = len(arrays.get("ref_times", ()))
             scalars = {**scalars, "dissipated": 0.0}
             arrays = {**arrays, "last_collision": np.full(n, -np.inf)}
+            version = 3
+        if version == 3:
+            n = len(arrays.get("ref_times", ()))
+            arrays = {**arrays, "spins": np.zeros(n), "angles": np.zeros(n)}
             version = cls.VERSION
         return super().from_arrays(scalars, arrays, version)
 

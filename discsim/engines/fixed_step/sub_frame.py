@@ -36,12 +36,19 @@ import numpy as np
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.engines.fixed_step.broad_phase import AllDiscs, BroadPhase, CellTable
 from discsim.engines.fixed_step.frame import Policy, point_segment_distance, segments_cut, walls_crossed
-from discsim.engines.fixed_step.parts import impulse_virial, kinetic_loss, restitution
+from discsim.engines.fixed_step.parts import (
+    impulse_virial,
+    kinetic_loss,
+    restitution,
+    rough_pair,
+    segment_bounce,
+    spin_loss,
+    wall_bounce,
+)
 from discsim.errors import InvalidArgumentError, JammedError
 from discsim.events import Event, EventKind
 from discsim.kernels import (
     closest_point_on_segment,
-    reflect_off_segment,
     resolve_collision,
     segment_time_of_impact,
     time_of_impact,
@@ -50,7 +57,6 @@ from discsim.kernels import (
 )
 from discsim.model import minimum_image_1d
 from discsim.physics.dynamics import advance
-from discsim.physics.laws import reflect
 
 __all__ = ["SUB_FRAME_POLICY_CLASSES", "Bisect", "SubFrame", "SubFramePolicy", "Swept"]
 
@@ -265,7 +271,18 @@ class SubFrame:
         ma, mb = shapes.masses[a], shapes.masses[b]
         e = self._restitution(a, b, tc)
         uxa, uya, uxb, uyb = resolve_collision(dx, dy, vxa, vya, vxb, vyb, ma, mb, e)
-        if e != 1.0:
+        if shapes.rough:  # the tangential impulse at the contact point turns both
+            spins, inertia = paths.spins, shapes.inertias
+            paths.spin_to(a, tc)
+            paths.spin_to(b, tc)
+            wa, wb = float(spins[a]), float(spins[b])
+            uxa, uya, uxb, uyb, spins[a], spins[b] = rough_pair(
+                dx, dy, vxa, vya, vxb, vyb, uxa, uya, uxb, uyb, wa, wb, shapes.radius[a], shapes.radius[b], ma, mb,
+                inertia[a], inertia[b], shapes.beta,
+            )  # fmt: skip
+            self.tally.dissipated += spin_loss(inertia[a], wa, float(spins[a]))
+            self.tally.dissipated += spin_loss(inertia[b], wb, float(spins[b]))
+        if e != 1.0 or shapes.rough:
             self.tally.dissipated += kinetic_loss(ma, vxa, vya, uxa, uya) + kinetic_loss(mb, vxb, vyb, uxb, uyb)
         if shapes.tc > 0.0:  # the TC model's clocks (an obstacle keeps none, as in EventDriven)
             for d in (a, b):
@@ -294,8 +311,10 @@ class SubFrame:
         if (v <= 0.0) if high else (v >= 0.0):  # moving away from this wall already
             return
         e = self._restitution(a, a, tc)
-        ux, uy = reflect(vx, vy, axis, e)
-        self._reflected(tc, a, x, y, vx, vy, ux, uy, e, WALL, wall)
+        shapes, w = self.shapes, float(self.paths.spins[a])
+        r, m, inertia = shapes.radius[a], shapes.masses[a], shapes.inertias[a]
+        ux, uy, w = wall_bounce(vx, vy, axis, not high, e, w, r, m, inertia, shapes.beta)
+        self._reflected(tc, a, x, y, vx, vy, ux, uy, e, WALL, wall, w)
 
     def _segment(self, tc: float, a: int, k: int) -> None:
         x, y = self.at(a, tc)
@@ -305,8 +324,10 @@ class SubFrame:
         if vx * (x - qx) + vy * (y - qy) >= 0.0:  # receding
             return
         e = self._restitution(a, a, tc)
-        ux, uy = reflect_off_segment(x, y, vx, vy, ax, ay, bx, by, e)
-        self._reflected(tc, a, x, y, vx, vy, ux, uy, e, SEGMENT, k)
+        shapes, w = self.shapes, float(self.paths.spins[a])
+        r, m, inertia = shapes.radius[a], shapes.masses[a], shapes.inertias[a]
+        ux, uy, w = segment_bounce(x, y, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, shapes.beta)
+        self._reflected(tc, a, x, y, vx, vy, ux, uy, e, SEGMENT, k, w)
 
     def _restitution(self, a: int, b: int, now: float) -> float:
         """The restitution of a response of discs ``a`` and ``b`` (``a`` twice: a wall or segment) at ``now``."""
@@ -315,9 +336,15 @@ class SubFrame:
             a, b, now, shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc, self.paths.last_collision
         )
 
-    def _reflected(self, tc, a, x, y, wx, wy, vx, vy, e, kind: EventKind, other: int) -> None:
-        """Disc ``a`` bounced at ``tc`` at ``(x, y)`` from velocity ``(wx, wy)`` to ``(vx, vy)`` (restitution ``e``)."""
-        if e != 1.0:
+    def _reflected(self, tc, a, x, y, wx, wy, vx, vy, e, kind: EventKind, other: int, spin: float) -> None:
+        """Disc ``a`` bounced at ``tc`` at ``(x, y)`` from velocity ``(wx, wy)`` to ``(vx, vy)`` (restitution ``e``),
+        its spin now ``spin``."""
+        shapes, paths = self.shapes, self.paths
+        if shapes.rough:
+            paths.spin_to(a, tc)
+            self.tally.dissipated += spin_loss(shapes.inertias[a], float(paths.spins[a]), spin)
+            paths.spins[a] = spin
+        if e != 1.0 or shapes.rough:
             self.tally.dissipated += kinetic_loss(self.shapes.masses[a], wx, wy, vx, vy)
         if self.shapes.tc > 0.0:
             self.paths.last_collision[a] = tc

@@ -155,6 +155,28 @@ def test_both_backends_give_the_same_frames_under_gravity_and_restitution(scene,
 
 @needs_numba
 @pytest.mark.parametrize("policy", COMPILED_POLICIES)
+@pytest.mark.parametrize("scene", ["walled", "periodic"])
+def test_both_backends_give_the_same_frames_under_roughness(scene, policy):
+    """Rough discs (spins, given inertia; walls, segments and obstacles as rough as them) with restitution: the same
+    log, state (the spins and angles too) and energy dissipated, bit for bit."""
+    discs, box, options = SCENES[scene]()
+    rng = np.random.default_rng(11)
+    n = len(discs)
+    inertia = np.where(np.isfinite(discs.masses), rng.uniform(0.2, 0.6, n) * discs.masses * discs.radii**2, np.inf)
+    spins = rng.normal(size=n)
+    discs = ds.Discs(discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups, spins, inertia)
+    runs = [
+        ds.FixedStep(discs, box, policy=policy, backend=b, restitution=0.9, roughness=0.4, **options).run(frames=120)
+        for b in BOTH
+    ]
+    assert runs[0].counts["detections"] > 300 and runs[0].dissipated > 0.0
+    assert not np.array_equal(runs[0].spins, spins)
+    assert_identical(*runs)
+    assert runs[0].dissipated == runs[1].dissipated and runs[0].kinetic_energy() == runs[1].kinetic_energy()
+
+
+@needs_numba
+@pytest.mark.parametrize("policy", COMPILED_POLICIES)
 def test_a_large_gas_gives_the_same_frames_and_the_same_verlet_list(policy):
     discs, box, options = large()
     runs = [ds.FixedStep(discs, box, policy=policy, backend=b, **options).run(frames=40) for b in ("python", "numba")]

@@ -6,8 +6,8 @@ backends give the same frames bit for bit: the move on the lazy clocks, the wall
 segment hits (by disc, then segment), then the overlapping pairs sorted by ``(i, j)``, each pair seeing the
 velocities the pairs before it left. The Verlet list of the ``"grid"`` broad phase is rebuilt in the same
 order as :func:`discsim.cells.neighbour_pairs` gives its pairs, so the exported state is the same too.
-Python's ``math.hypot`` (used by ``"separate"``) is not the C library's ``hypot``: :func:`cpython_hypot`
-is CPython's own algorithm, so the two agree to the last bit.
+Python's ``math.hypot`` (used by ``"separate"``) is not the C library's ``hypot``: ``cpython_hypot``
+(:mod:`~discsim.engines.fixed_step.numba.hypot`) is CPython's own algorithm, so the two agree to the last bit.
 
 :func:`frames` does a batch of frames in one call (a run's frames cost no interpreter time between them).
 Every function is ``njit(cache=True)`` (no fastmath: it would reorder the floating-point operations); the
@@ -26,12 +26,12 @@ import numpy as np
 from discsim._compiled import compile_from_source
 from discsim._numba import numba
 from discsim.engines.fixed_step import parts
+from discsim.engines.fixed_step.numba.hypot import cpython_hypot
 from discsim.model import image_step, minimum_image_1d
+from discsim.physics import laws
 from discsim.physics.compiled import advance
 from discsim.physics.compiled import closest_point_on_segment as _closest_point
 from discsim.physics.compiled import collide as _collide
-from discsim.physics.compiled import reflect as _reflect_wall
-from discsim.physics.compiled import reflect_off_segment as _reflect
 
 _nb = numba()
 if _nb is None:  # pragma: no cover - the engine imports this module only when numba imports
@@ -58,6 +58,15 @@ _parts = compile_from_source(
         parts.push_off_segment,
         parts.restitution,
         parts.kinetic_loss,
+        laws.reflect,
+        laws.closest_point_on_segment,
+        laws.reflect_off_segment,
+        laws.rough_impulse,
+        parts.spin_loss,
+        parts.rough_pair,
+        parts._rough_bounce,
+        parts.wall_bounce,
+        parts.segment_bounce,
     ),
     jit,
 )
@@ -70,78 +79,21 @@ _image = _parts[parts.box_image]  # as Box.minimum_image computes it on arrays (
 _impulse_virial = _parts[parts.impulse_virial]
 _restitution = _parts[parts.restitution]
 _kinetic_loss = _parts[parts.kinetic_loss]
+_spin_loss = _parts[parts.spin_loss]
+_rough_pair = _parts[parts.rough_pair]
+_wall_bounce = _parts[parts.wall_bounce]
+_segment_bounce = _parts[parts.segment_bounce]
 
 #: The compiled policies by name: the ``policy`` argument of :func:`frames`.
 POLICY_CODES = {"resolve": 0, "revert": 1, "separate": 2}
 RESOLVE, REVERT, SEPARATE = 0, 1, 2
 INF = math.inf
-_DBL_MIN = 2.2250738585072014e-308
-_VELTKAMP = 134217729.0  # 2 ** 27 + 1
 # The cell offsets of discsim.cells.neighbour_pairs, in its order.
 _OFFSETS_X = (0, 1, 1, 0, -1)
 _OFFSETS_Y = (0, 0, 1, 1, 1)
 
 
 # --- scalar helpers --------------------------------------------------------------------------------------
-@jit
-def cpython_hypot(x, y):
-    """``math.hypot(x, y)`` as CPython 3.10 and 3.11 compute it (Veltkamp splitting, differential correction).
-
-    Example:
-        >>> cpython_hypot(3.0, 4.0)
-        5.0
-    """
-    x, y = abs(x), abs(y)
-    top = 0.0  # the largest, NaN skipped: hypot(inf, nan) is inf
-    if x > top:
-        top = x
-    if y > top:
-        top = y
-    if math.isinf(top):
-        return top
-    if math.isnan(x) or math.isnan(y):
-        return math.nan
-    if top == 0.0:
-        return top
-    _, top_e = math.frexp(top)
-    if top_e < -1023:  # subnormal: 2 ** -top_e would overflow
-        return _DBL_MIN * cpython_hypot(x / _DBL_MIN, y / _DBL_MIN)
-    scale = math.ldexp(1.0, -top_e)
-    csum, frac1, frac2, frac3 = 1.0, 0.0, 0.0, 0.0
-    for v in (x, y):
-        v = v * scale
-        t = v * _VELTKAMP
-        hi = t - (t - v)
-        lo = v - hi
-        w = hi * hi
-        old = csum
-        csum += w
-        frac1 += (old - csum) + w
-        w = 2.0 * hi * lo
-        old = csum
-        csum += w
-        frac2 += (old - csum) + w
-        frac3 += lo * lo
-    h = math.sqrt(csum - 1.0 + (frac1 + frac2 + frac3))
-    t = h * _VELTKAMP
-    hi = t - (t - h)
-    lo = h - hi
-    w = -hi * hi
-    old = csum
-    csum += w
-    frac1 += (old - csum) + w
-    w = -2.0 * hi * lo
-    old = csum
-    csum += w
-    frac2 += (old - csum) + w
-    w = -lo * lo
-    old = csum
-    csum += w
-    frac3 += (old - csum) + w
-    w = csum - 1.0 + (frac1 + frac2 + frac3)
-    return (h + w / (2.0 * h)) / scale
-
-
 @jit
 def _segment_distance(px, py, ax, ay, bx, by):
     """:func:`discsim.engines.fixed_step.frame.point_segment_distance` of one point and one segment."""
@@ -183,34 +135,54 @@ def _log_wall(ev_n, ev_f, k, frame, i, x, y, vx, vy):
     return ev_n, ev_f
 
 
+@jit
+def _spin_to(i, t, spins, angles, angle_t):
+    """``Paths.spin_to``: disc ``i``'s angle brought to time ``t`` (before its spin changes there)."""
+    angles[i] += spins[i] * (t - angle_t[i])
+    angle_t[i] = t
+
+
 # --- the steps of a frame --------------------------------------------------------------------------------
 @jit
-def _walls(policy, pos, prev, vel, radii, masses, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws):
-    """Discs past a wall and moving outwards: reverse the normal velocity (with restitution); returns
-    ``(k, ev_n, ev_f)``."""
+def _walls(
+    policy, pos, prev, vel, radii, masses, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws, turning
+):
+    """Discs past a wall and moving outwards: reverse the normal velocity (with restitution and roughness);
+    returns ``(k, ev_n, ev_f)``."""
     _, _, _, e0, per_group, table, group, tc, last, lost = laws
+    beta, inertia, spins, angles, angle_t = turning
+    rough = beta != -1.0
     for i in range(len(pos)):
         r = radii[i]
         hit = False
-        wx = wy = 0.0
+        wx, wy = vel[i, 0], vel[i, 1]
         e = 1.0
+        w0 = w = spins[i]
         for axis in range(2):
             size = width if axis == 0 else height
-            p, v = pos[i, axis], vel[i, axis]
+            p, v = pos[i, axis], (wx if axis == 0 else wy)  # walls_crossed: the velocity at the frame
             low = p < r and v < 0.0
             high = p > size - r and v > 0.0
             if low or high:
                 if not hit:
-                    wx, wy = vel[i, 0], vel[i, 1]
                     e = _restitution(i, i, t, e0, per_group, table, group, tc, last)
                 hit = True
-                vel[i, 0], vel[i, 1] = _reflect_wall(vel[i, 0], vel[i, 1], axis, e)
+                u = vel[i, axis]
+                if (u < 0.0) if low else (u > 0.0):  # still outwards (a rough bounce off the other wall may turn it)
+                    vel[i, 0], vel[i, 1], w = _wall_bounce(
+                        vel[i, 0], vel[i, 1], axis, low, e, w, r, masses[i], inertia[i], beta
+                    )
                 if policy == SEPARATE:
                     pos[i, axis] = r if low else size - r
         if not hit:
             continue
-        if e != 1.0:
+        if rough:
+            _spin_to(i, t, spins, angles, angle_t)
+        if e != 1.0 or rough:
             lost[0] += _kinetic_loss(masses[i], wx, wy, vel[i, 0], vel[i, 1])
+        if rough:
+            spins[i] = w
+            lost[0] += _spin_loss(inertia[i], w0, w)
         if tc > 0.0:
             last[i] = t
         if policy == REVERT:
@@ -223,11 +195,12 @@ def _walls(policy, pos, prev, vel, radii, masses, width, height, ref_pos, ref_t,
 
 
 @jit
-def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e):
-    """One disc cutting the segments ``cut`` (in order): ``(x, y, vx, vy, responded)``.
+def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e, w, m, inertia, beta):
+    """One disc cutting the segments ``cut`` (in order): ``(x, y, vx, vy, w, responded)``.
 
     ``FramePolicy.off_segments`` (``"resolve"``, ``"separate"``) and ``Revert.off_segments``; ``(px, py)``
-    is the disc's position at the previous frame.
+    is the disc's position at the previous frame; ``w``, ``m``, ``inertia``: its spin, mass, moment of inertia;
+    ``beta``: the roughness.
     """
     responded = False
     reverted = False
@@ -244,22 +217,24 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e):
                 fx, fy = x, y
                 x, y = px, py
                 reverted = True
-                vx, vy = _reflect(fx, fy, vx, vy, ax, ay, bx, by, e)
+                vx, vy, w = _segment_bounce(fx, fy, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, beta)
                 responded = True
                 continue
         if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
             continue
         if policy == SEPARATE:
             x, y = _push_off_segment(x, y, qx, qy, nx, ny, r, cpython_hypot(nx, ny))
-        vx, vy = _reflect(x, y, vx, vy, ax, ay, bx, by, e)
+        vx, vy, w = _segment_bounce(x, y, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, beta)
         responded = True
-    return x, y, vx, vy, responded
+    return x, y, vx, vy, w, responded
 
 
 @jit
-def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws):
+def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws, turning):
     """Discs cutting a segment, each answered by :func:`_off_segments`; returns ``(k, ev_n, ev_f)``."""
     _, _, _, e0, per_group, table, group, tc, last, lost = laws
+    beta, inertia, spins, angles, angle_t = turning
+    rough = beta != -1.0
     cut = np.empty(len(segments), dtype=np.int64)
     for i in range(len(pos)):
         x, y, r = pos[i, 0], pos[i, 1], radii[i]
@@ -272,10 +247,17 @@ def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t
             continue
         wx, wy = vel[i, 0], vel[i, 1]
         e = _restitution(i, i, t, e0, per_group, table, group, tc, last)
-        x, y, vx, vy, responded = _off_segments(policy, x, y, wx, wy, prev[i, 0], prev[i, 1], segments, cut[:m], r, e)
+        w0 = spins[i]
+        x, y, vx, vy, w, responded = _off_segments(
+            policy, x, y, wx, wy, prev[i, 0], prev[i, 1], segments, cut[:m], r, e, w0, masses[i], inertia[i], beta
+        )
         if responded:
-            if e != 1.0:
+            if e != 1.0 or rough:
                 lost[0] += _kinetic_loss(masses[i], wx, wy, vx, vy)
+            if rough:
+                _spin_to(i, t, spins, angles, angle_t)
+                spins[i] = w
+                lost[0] += _spin_loss(inertia[i], w0, w)
             if tc > 0.0:
                 last[i] = t
             pos[i, 0], pos[i, 1] = x, y
@@ -516,7 +498,7 @@ def _contact(policy, xi, yi, xj, yj, dx, dy, dvx, dvy, mi, mj, sigma, prev, i, j
 
 
 @jit
-def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial, laws):
+def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial, laws, turning):
     """Answer the overlapping pairs in order (keys ``i * N + j``); returns ``(k, virial)``: the events
     written so far and the collision virial with these responses added.
 
@@ -526,6 +508,8 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
     ref_pos, vel, ref_t, _ = paths
     radii, masses, periodic, width, height, _, _, _, _ = scene
     _, _, _, e0, per_group, table, group, tc, last, lost = laws
+    beta, inertia, spins, angles, angle_t = turning
+    rough = beta != -1.0
     n = len(pos)
     for key in keys:
         i, j = key // n, key % n
@@ -544,7 +528,17 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
         )
         e = _restitution(i, j, t, e0, per_group, table, group, tc, last)
         uxi, uyi, uxj, uyj = _collide(dx, dy, vxi, vyi, vxj, vyj, mi, mj, e)
-        if e != 1.0:
+        if rough:  # the tangential impulse at the contact point turns both
+            _spin_to(i, t, spins, angles, angle_t)
+            _spin_to(j, t, spins, angles, angle_t)
+            wi, wj = spins[i], spins[j]
+            uxi, uyi, uxj, uyj, spins[i], spins[j] = _rough_pair(
+                dx, dy, vxi, vyi, vxj, vyj, uxi, uyi, uxj, uyj, wi, wj, radii[i], radii[j], mi, mj,
+                inertia[i], inertia[j], beta,
+            )  # fmt: skip
+            lost[0] += _spin_loss(inertia[i], wi, spins[i])
+            lost[0] += _spin_loss(inertia[j], wj, spins[j])
+        if e != 1.0 or rough:
             lost[0] += _kinetic_loss(mi, vxi, vyi, uxi, uyi) + _kinetic_loss(mj, vxj, vyj, uxj, uyj)
         if tc > 0.0:  # the TC model's clocks (an obstacle keeps none)
             if mi != INF:
@@ -577,7 +571,9 @@ C_PAIR_TESTS, C_SEGMENT_TESTS, C_DETECTIONS, C_WALL_HITS, C_LIST_BUILDS = range(
 
 
 @jit
-def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap, virial, laws):
+def _frame(
+    policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k, counts, overlap, virial, laws, turning
+):
     """One frame at time ``t`` (index ``frame`` in the batch): from ``frame_pos`` (the last frame's
     positions) to ``pos`` (written); see :func:`frames`.
 
@@ -605,13 +601,15 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
     first = k
     if not periodic:
         k, ev_n, ev_f = _walls(
-            policy, pos, frame_pos, vel, radii, masses, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws
-        )
+            policy, pos, frame_pos, vel, radii, masses, width, height, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws,
+            turning,
+        )  # fmt: skip
     if len(segments):
         counts[C_SEGMENT_TESTS] += n * len(segments)
         k, ev_n, ev_f = _segments(
-            policy, pos, frame_pos, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws
-        )
+            policy, pos, frame_pos, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws,
+            turning,
+        )  # fmt: skip
     counts[C_WALL_HITS] += k - first
     if not all_pairs and (len(list_pos) == 0 or _stale(pos, list_pos, periodic, width, height, limit2)):
         list_i, list_j = build_list(
@@ -629,7 +627,7 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
         flown = np.empty((n if periodic else 0, 2))
         before = k
         k, virial = _pairs(
-            policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial, laws
+            policy, keys, pos, frame_pos, paths, t, scene, changed, flown, ev_n, ev_f, k, frame, virial, laws, turning
         )
         counts[C_DETECTIONS] += k - before
         for i in range(n):  # Paths.restart
@@ -647,7 +645,7 @@ def _frame(policy, t, frame, scene, paths, broad, frame_pos, pos, ev_n, ev_f, k,
 
 
 @jit
-def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws):
+def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws, turning):
     """Frames at ``times`` one after the other: move every disc to the frame, then answer what overlaps there.
 
     Changes the paths in place, as ``FramePolicy.frame`` changes
@@ -672,6 +670,8 @@ def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws):
             (``Shapes``' ``e``, ``per_group``, ``e_table`` ``(G, G)``, ``e_group`` ``(N,)`` int64, ``tc``, and
             ``Paths.last_collision``, changed in place), and ``lost`` ``(1,)``: ``Tally.dissipated``, added to
             in place.
+        turning: ``(beta, inertia, spins, angles, angle_times)``: the roughness (-1: smooth, the rest unread), the
+            moments of inertia ``(N,)``, and ``Paths.spins``, ``angles``, ``angle_times`` (changed in place).
 
     Returns:
         ``(ev_n, ev_f, frame_pos, list_pos, list_i, list_j, overlap, virial)``: the events, in order, as
@@ -689,7 +689,7 @@ def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws):
     for f in range(len(times)):
         here = (all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y)
         k, ev_n, ev_f, list_pos, list_i, list_j, overlap, virial = _frame(
-            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap, virial, laws
+            policy, times[f], f, scene, moving, here, prev, pos, ev_n, ev_f, k, counts, overlap, virial, laws, turning
         )
         prev, pos = pos, prev
     return ev_n[:k], ev_f[:k], prev, list_pos, list_i, list_j, overlap, virial

@@ -75,6 +75,12 @@ def _law_arrays(shapes: Shapes) -> tuple:
     )
 
 
+def _turning_arrays(shapes: Shapes) -> tuple[float, np.ndarray]:
+    """The fixed slots of the ``turning`` argument of the compiled frames: the roughness and the moments of inertia
+    (the spins and angles, ``Paths``', come with each call)."""
+    return float(shapes.beta), np.ascontiguousarray(shapes.inertia, dtype=np.float64)
+
+
 def _records(at: np.ndarray, ev_n: np.ndarray, states: np.ndarray) -> np.ndarray:
     """Log records of events at times ``at``: discs ``ev_n[:, 1:3]`` (j < 0: a wall or segment hit), the
     state after in ``states`` ``(E, 8)``."""
@@ -117,6 +123,7 @@ class CompiledFrame(Policy):
         n = len(scene)
         self._scene = _scene_arrays(shapes)
         self._laws = _law_arrays(shapes)
+        self._beta, self._inertia = _turning_arrays(shapes)
         self._lost = np.zeros(1)
         self._verlet = broad if isinstance(broad, VerletGrid) else None  # the "grid" broad phase keeps the list
         if isinstance(broad, VerletGrid):
@@ -157,8 +164,9 @@ class CompiledFrame(Policy):
         lost = self._lost
         lost[0] = tally.dissipated
         laws = (*self._laws, paths.last_collision, lost)
+        turning = (self._beta, self._inertia, paths.spins, paths.angles, paths.angle_times)
         ev_n, ev_f, paths.frame_positions, list_pos, list_i, list_j, overlap, virial = kernels.frames(
-            self._code, times, self._scene, state, listed, counts, tally.max_overlap, tally.virial, laws
+            self._code, times, self._scene, state, listed, counts, tally.max_overlap, tally.virial, laws, turning
         )
         tally.max_overlap = overlap
         tally.virial = virial
@@ -196,6 +204,7 @@ class CompiledSubFrame(Policy):
         self._counts = np.zeros(5, dtype=np.int64)
         self._acc = np.zeros(3)
         self._laws = _law_arrays(shapes)[3:]  # the restitution (the sub-frame policies refuse gravity)
+        self._beta, self._inertia = _turning_arrays(shapes)
         self._jam = np.zeros(3, dtype=np.int64)
         self._swept = Swept(shapes, broad) if name == "swept" else None
         self._batch = max(1, BATCH_WORK // max(n, 1))
@@ -251,8 +260,9 @@ class CompiledSubFrame(Policy):
         acc[0], acc[1], acc[2] = tally.max_overlap, tally.virial, tally.dissipated
         state = (paths.ref_positions, paths.velocities, paths.ref_times, paths.images, paths.frame_positions)
         laws = (*self._laws, paths.last_collision)
+        turning = (self._beta, self._inertia, paths.spins, paths.angles, paths.angle_times)
         status, _, ev_n, ev_f, paths.frame_positions, jam_time = sub_frame.sub_frames(
-            self._code, times, float(t0), self._scene, self._sub, state, counts, acc, self._jam, laws
+            self._code, times, float(t0), self._scene, self._sub, state, counts, acc, self._jam, laws, turning
         )
         tally.max_overlap, tally.virial, tally.dissipated = float(acc[0]), float(acc[1]), float(acc[2])
         for name, step in zip(_SUB_COUNTERS, counts.tolist()):

@@ -77,9 +77,12 @@ from discsim.engines.fixed_step.numba.kernels import (
     _impulse_virial,
     _kinetic_loss,
     _nearest_image,
-    _reflect,
-    _reflect_wall,
     _restitution,
+    _rough_pair,
+    _segment_bounce,
+    _spin_loss,
+    _spin_to,
+    _wall_bounce,
     _wrap,
     cpython_hypot,
     jit,
@@ -136,14 +139,16 @@ def _at(paths, a, s):
 
 
 @leaf
-def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, counts, acc, laws):
+def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, counts, acc, laws, turning):
     """Answer the candidate: ``SubFrame._collide``, ``_wall`` or ``_segment``. Returns whether it did.
 
     ``acc``: the deepest overlap, the collision virial and the energy dissipated (changed in place);
-    ``laws``: the restitution, as for :func:`sub_frames`.
+    ``laws``: the restitution, ``turning``: the roughness and the spins, as for :func:`sub_frames`.
     """
     radii, masses, periodic, width, height, segments, _, _, _ = scene
     e0, per_group, table, group, tc_model, last = laws
+    beta, inertia, spins, angles, angle_t = turning
+    rough = beta != -1.0
     vel = paths[1]
     ev_n, ev_f = ev
     nan = math.nan
@@ -163,7 +168,17 @@ def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, count
         ma, mb = masses[a], masses[b]
         e = _restitution(a, b, tc, e0, per_group, table, group, tc_model, last)
         uxa, uya, uxb, uyb = _collide(dx, dy, vxa, vya, vxb, vyb, ma, mb, e)
-        if e != 1.0:
+        if rough:  # the tangential impulse at the contact point turns both
+            _spin_to(a, tc, spins, angles, angle_t)
+            _spin_to(b, tc, spins, angles, angle_t)
+            wa, wb = spins[a], spins[b]
+            uxa, uya, uxb, uyb, spins[a], spins[b] = _rough_pair(
+                dx, dy, vxa, vya, vxb, vyb, uxa, uya, uxb, uyb, wa, wb, radii[a], radii[b], ma, mb,
+                inertia[a], inertia[b], beta,
+            )  # fmt: skip
+            acc[2] += _spin_loss(inertia[a], wa, spins[a])
+            acc[2] += _spin_loss(inertia[b], wb, spins[b])
+        if e != 1.0 or rough:
             acc[2] += _kinetic_loss(ma, vxa, vya, uxa, uya) + _kinetic_loss(mb, vxb, vyb, uxb, uyb)
         if tc_model > 0.0:  # the TC model's clocks (an obstacle keeps none)
             if moving[a]:
@@ -186,15 +201,19 @@ def _respond(kind, tc, a, b, frame, paths, scene, moving, version, ev, st, count
         if (v <= 0.0) if high else (v >= 0.0):  # moving away from this wall already
             return False
         e = _restitution(a, a, tc, e0, per_group, table, group, tc_model, last)
-        vx, vy = _reflect_wall(wx, wy, axis, e)
+        vx, vy, w = _wall_bounce(wx, wy, axis, high == 0, e, spins[a], radii[a], masses[a], inertia[a], beta)
     else:
         ax, ay, bx, by = segments[b, 0], segments[b, 1], segments[b, 2], segments[b, 3]
         qx, qy = _closest_point(x, y, ax, ay, bx, by)
         if wx * (x - qx) + wy * (y - qy) >= 0.0:  # receding
             return False
         e = _restitution(a, a, tc, e0, per_group, table, group, tc_model, last)
-        vx, vy = _reflect(x, y, wx, wy, ax, ay, bx, by, e)
-    if e != 1.0:
+        vx, vy, w = _segment_bounce(x, y, wx, wy, ax, ay, bx, by, e, spins[a], radii[a], masses[a], inertia[a], beta)
+    if rough:
+        _spin_to(a, tc, spins, angles, angle_t)
+        acc[2] += _spin_loss(inertia[a], spins[a], w)
+        spins[a] = w
+    if e != 1.0 or rough:
         acc[2] += _kinetic_loss(masses[a], wx, wy, vx, vy)
     if tc_model > 0.0:
         last[a] = tc
@@ -281,7 +300,7 @@ def _recheck(code, a, now, t, kind, other, near, count, p, tol, paths, scene, tw
 
 # --- the frames ------------------------------------------------------------------------------------------------
 @jit
-def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam, laws):
+def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam, laws, turning):
     """Frames at ``times`` one after the other, each answering its contacts at their times.
 
     Changes the paths in place as ``SubFramePolicy.frame`` changes
@@ -301,6 +320,8 @@ def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam, laws):
         laws: ``(e, per_group, e_table, e_group, tc, last_collision)``: the arguments of
             :func:`~discsim.engines.fixed_step.parts.restitution` (``last_collision`` changed in place; no
             gravity: the sub-frame policies refuse it).
+        turning: ``(beta, inertia, spins, angles, angle_times)``, as for
+            :func:`~discsim.engines.fixed_step.numba.kernels.frames`.
 
     Returns:
         ``(status, frames, ev_n, ev_f, frame_pos, jam_time)``: :data:`DONE`, or :data:`JAMMED` when a
@@ -384,7 +405,8 @@ def sub_frames(code, times, t0, scene, sub, paths, counts, acc, jam, laws):
                 jam[0], jam[1], jam[2] = a, b, kind
                 return JAMMED, f, ev_n[: st[S_EVENTS]], ev_f[: st[S_EVENTS]], prev, tc
             ev_n, ev_f = _room_i2(ev_n, st[S_EVENTS] + 1), _room_f2(ev_f, st[S_EVENTS] + 1)
-            if not _respond(kind, tc, a, b, f, moved, scene, moving, version, (ev_n, ev_f), st, counts, acc, laws):
+            ev = (ev_n, ev_f)
+            if not _respond(kind, tc, a, b, f, moved, scene, moving, version, ev, st, counts, acc, laws, turning):
                 continue
             for q in range(2):  # the discs that changed course test their new paths
                 disc, partner = (a, b) if q == 0 else (b, a)

@@ -13,6 +13,10 @@ each law in turn (so a slow spell hits them alike), ``--repeats`` times (default
 * ``gravity+restitution``: both (the gas settles while it is timed).
 * ``rough``: no gravity, elastic, ``roughness=0.5``: rough discs that spin (they start without spin).
 * ``perfectly rough``: the same at ``roughness=1`` (energy conserved: the spins take their share and keep it).
+* ``drag``: no gravity, elastic, ``drag=gamma`` with ``1 / gamma`` a hundred mean free times (the gas slows to
+  about half its kinetic energy while it is timed): exponential flight, every time in closed form.
+* ``gravity+drag``: both (walls and cell edges along gravity by bracketed roots; the gas falls towards its
+  terminal velocity).
 
 Under any law but the first the pure-Python backend runs the compiled loop's source interpreted (its own loop
 knows free flight only). The issue's target: the compiled backend within 1.5x of its elastic rate under gravity
@@ -29,7 +33,7 @@ from benchutils import Column, call_fresh, format_table, machine_summary, median
 
 import discsim as ds
 
-LAWS = ("elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough")
+LAWS = ("elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough", "drag", "gravity+drag")
 KEYS = ["backend", "law", "n", "events", "collisions_per_s", "ratio_to_elastic", "repeats"]
 COLUMNS = [
     Column("backend", "backend", "s"),
@@ -47,11 +51,13 @@ def keywords(law: str, discs, box) -> dict:
     out: dict = {}
     if "gravity" in law:
         out["gravity"] = (0.0, -2.0 * kt / box.height)  # scale height kT / (m g) = half the box
+    n_density = len(discs) / box.area
+    sigma = 2.0 * float(discs.radii.mean())
+    free_time = 1.0 / (n_density * sigma * (kt * 3.14159) ** 0.5 * 2**0.5)
     if "restitution" in law:
-        n_density = len(discs) / box.area
-        sigma = 2.0 * float(discs.radii.mean())
-        free_time = 1.0 / (n_density * sigma * (kt * 3.14159) ** 0.5 * 2**0.5)
         out.update(restitution=0.9, tc=free_time / 100.0)
+    if "drag" in law:
+        out["drag"] = 1.0 / (100.0 * free_time)
     if law == "rough":
         out["roughness"] = 0.5
     if law == "perfectly rough":

@@ -12,7 +12,7 @@ from paths import PACKAGE
 FLOORS = {
     "ground": ["model", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled", "_progress", "_version"],
     "model": ["scene", "laws", "events", "cells", "repair", "spatial"],
-    "physics": ["physics", "kernels", "trajectory"],
+    "physics": ["physics", "kernels", "trajectory", "losses"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "view", "scenarios", "__init__", "__main__"],
 }

@@ -177,12 +177,12 @@ class DiscEditing:
         context = self.run_context
         ids = np.arange(context.next_id, context.next_id + k, dtype=np.int64)
         ids_after, origin = np.concatenate([self.ids, ids]), self._log_origin()
-        resting = self._resting_ids()
+        resting = _resting_ids(self)
         self._restructure(np.arange(n), discs, new_scene)
         self._new_discs(new_scene, ids_after, context.next_id + k, origin)
         if self._logging or context.streamed:
             context.log.add(self.time, ids, discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups)
-        self._log_woken(resting)
+        _log_woken(self, resting)
         self._edits += k
         return np.arange(n, n + k, dtype=np.int64)
 
@@ -221,12 +221,12 @@ class DiscEditing:
         scene = self.scene
         new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
         gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()
-        resting = self._resting_ids()
+        resting = _resting_ids(self)
         self._restructure(keep, None, new_scene)
         self._new_discs(new_scene, ids_after, self.run_context.next_id, origin)
         if self._logging or self.run_context.streamed:
             self.run_context.log.remove(self.time, gone, gone_positions, gone_velocities)
-        self._log_woken(resting)
+        _log_woken(self, resting)
         self._edits += len(idx)
         return self
 
@@ -358,7 +358,7 @@ class DiscEditing:
             raise UnitsError(msg)
         if positions is not None:
             self._check_places(idx, positions)
-        resting = self._resting_ids()
+        resting = _resting_ids(self)
         if len(idx):
             self._set_discs(idx, positions, velocities)
         self._edits += len(idx)
@@ -366,27 +366,7 @@ class DiscEditing:
             t, pos, vel, ids = self.time, self.positions[idx], self.velocities[idx], self.ids[idx]
             for k, i in enumerate(ids.tolist()):
                 self.run_context.log.set(t, i, pos[k, 0], pos[k, 1], vel[k, 0], vel[k, 1])
-        self._log_woken(np.setdiff1d(resting, self.ids[idx]))
-
-    def _resting_ids(self) -> np.ndarray:
-        """The ids of the discs at rest now (under gravity; none for engines without rest)."""
-        laws = getattr(self, "laws", None)
-        if laws is None or not laws.falls or not hasattr(self, "resting"):
-            return np.zeros(0, dtype=np.int64)
-        return self.ids[self.resting]
-
-    def _log_woken(self, resting: np.ndarray) -> None:
-        """A ``SET`` record (where it is, velocity zero) for each disc of ``resting`` (ids, at rest before an edit)
-        that the edit woke: it falls from here, which the log must say (its last record says it rests), so that
-        :meth:`trajectory`, the viewer and replays follow its fall. The compiled loop logs the discs a hit wakes
-        the same way."""
-        if not len(resting) or not (self._logging or self.run_context.streamed):
-            return
-        ids = self.ids
-        woken = np.flatnonzero(np.isin(ids, resting) & ~self.resting)
-        t, pos = self.time, self.positions
-        for k in woken.tolist():
-            self.run_context.log.set(t, int(ids[k]), pos[k, 0], pos[k, 1], 0.0, 0.0)
+        _log_woken(self, np.setdiff1d(resting, self.ids[idx]))
 
     def _check_places(self, idx: np.ndarray, positions: np.ndarray) -> None:
         """Refuse positions outside the box, cut by a wall or a segment, or overlapping another disc."""
@@ -469,3 +449,25 @@ class Uneditable:
     def _refuse(self, what: str) -> NoReturn:
         msg = f"a {type(self).__name__} cannot {what}: {self.EDIT_REFUSAL}"
         raise DiscsimError(msg)
+
+
+def _resting_ids(engine) -> np.ndarray:
+    """The ids of ``engine``'s discs at rest now (under gravity; none for engines without rest)."""
+    laws = getattr(engine, "laws", None)
+    if laws is None or not laws.falls or not hasattr(engine, "resting"):
+        return np.zeros(0, dtype=np.int64)
+    return engine.ids[engine.resting]
+
+
+def _log_woken(engine, resting: np.ndarray) -> None:
+    """A ``SET`` record (where it is, velocity zero) for each disc of ``resting`` (ids, at rest before an edit of
+    ``engine``) that the edit woke: it falls from here, which the log must say (its last record says it rests), so
+    that ``trajectory()``, the viewer and replays follow its fall. The compiled loop logs the discs a hit wakes the
+    same way."""
+    if not len(resting) or not (engine._logging or engine.run_context.streamed):
+        return
+    ids = engine.ids
+    woken = np.flatnonzero(np.isin(ids, resting) & ~engine.resting)
+    t, pos = engine.time, engine.positions
+    for k in woken.tolist():
+        engine.run_context.log.set(t, int(ids[k]), pos[k, 0], pos[k, 1], 0.0, 0.0)

@@ -15,8 +15,9 @@ import numpy as np
 from discsim.engines.context import RunContext
 from discsim.errors import InvalidArgumentError
 from discsim.events import COLLISION, EVENT_DTYPE
+from discsim.losses import event_losses
 from discsim.model import Box, Discs
-from discsim.trajectory import positions_from_log
+from discsim.trajectory import log_start, positions_from_log
 
 __all__ = ["EventRecord", "collision_virials"]
 
@@ -95,6 +96,49 @@ class EventRecord:
             ids=ids,
             gravity=self._gravity(),
             drag=getattr(getattr(self, "laws", None), "drag", 0.0),
+        )
+
+    def event_losses(self) -> np.ndarray:
+        """``(E,)`` the kinetic energy (mass length^2 / time^2) each record of :attr:`events` took: a collision or
+        wall hit with restitution below 1, a rough one (its rotational part too, in an event-driven run), a bounce
+        that ended in rest; 0 for elastic, smooth ones and for ``SET``, ``ADD`` and ``REMOVE`` records.
+
+        Read from the log (:func:`discsim.losses.event_losses`): each disc's velocity just before an event is its
+        previous record's carried along the law of motion. Summed, they are :attr:`dissipated` less what the drag
+        took between events (all of it without drag), to rounding.
+
+        Raises:
+            InvalidArgumentError: if the engine does not hold its log (``record=False``, or streamed to disk).
+
+        Example:
+            >>> import discsim as ds
+            >>> discs = ds.Discs([[5.0, 3.0]], [[0.0, 0.0]], radii=1.0)
+            >>> sim = ds.EventDriven(discs, ds.Box(10.0, 10.0), gravity=(0.0, -1.0), restitution=0.5)
+            >>> round(float(sim.run(until=2.5).event_losses()[0]), 12)  # lands at speed 2: 3/4 of 2 is lost
+            1.5
+        """
+        self._refuse_if_streamed("event_losses()")
+        if not self.record:
+            msg = "event_losses() needs the event log; build the engine with record=True"
+            raise InvalidArgumentError(msg)
+        events = self.run_context.log.to_array()
+        discs, ids = self._log_origin()
+        _, velocities, radii, masses, _ = log_start(events, discs, ids)
+        rows = np.arange(len(discs)) if ids is None else np.asarray(ids)
+        spins0, inertia = np.zeros(len(masses)), 0.5 * masses * radii**2  # discs added later: a uniform disc
+        spins0[rows], inertia[rows] = discs.spins, discs.inertia
+        laws = getattr(self, "laws", None)
+        spin_events = getattr(self, "spin_events", None) if laws is not None and laws.rough else None
+        return event_losses(
+            events,
+            velocities,
+            masses,
+            self.start_time,
+            laws.gravity if laws is not None else (0.0, 0.0),
+            laws.drag if laws is not None else 0.0,
+            spins0,
+            inertia,
+            spin_events,
         )
 
     def _gravity(self):

@@ -430,12 +430,14 @@ def _records(events, k: int) -> np.ndarray:
 
 
 def _spin_records(events, k: int) -> np.ndarray:
-    """The spins of the first ``k`` rows of the loop's log buffer as :data:`~discsim.events.SPIN_DTYPE` rows."""
-    ev_t, _, ev_i, ev_j, _, ev_w = events
-    out = np.empty(k, dtype=SPIN_DTYPE)
-    out["time"] = ev_t[:k]
-    out["i"] = ev_i[:k]
-    out["j"] = ev_j[:k]
-    out["wi"] = ev_w[:k, 0]
-    out["wj"] = ev_w[:k, 1]
+    """The spins after the collisions and wall hits among the first ``k`` rows of the loop's log buffer, as
+    :data:`~discsim.events.SPIN_DTYPE` rows (not the ``SET`` rows of discs a hit woke: their spins do not change)."""
+    ev_t, ev_kind, ev_i, ev_j, _, ev_w = events
+    rows = np.flatnonzero((ev_kind[:k] == int(EventKind.COLLISION)) | (ev_kind[:k] == int(EventKind.WALL)))
+    out = np.empty(len(rows), dtype=SPIN_DTYPE)
+    out["time"] = ev_t[rows]
+    out["i"] = ev_i[rows]
+    out["j"] = ev_j[rows]
+    out["wi"] = ev_w[rows, 0]
+    out["wj"] = ev_w[rows, 1]
     return out

@@ -281,12 +281,55 @@ def test_trajectories_follow_the_parabolas_and_the_rest(every_backend):
     assert sim.trajectory([rest, (rest + 5.0) / 2, 5.0])[:, 0].tolist() == [sim.positions[0].tolist()] * 3
 
 
-def test_replays_of_free_flight_refuse_a_run_under_gravity():
-    sim = ds.EventDriven(ball(5.0, 5.0, 1.0), BOX, gravity=(0.0, -G)).run(until=1.0)
-    with pytest.raises(InvalidArgumentError, match="gravity"):
-        ds.frames(sim, [0.5])
-    with pytest.raises(InvalidArgumentError, match="gravity"):
-        ds.view(sim)
+def test_frames_of_a_ball_thrown_under_gravity_follow_the_parabola_and_the_rest(every_backend, tmp_path):
+    e, r, vx, vy = 0.5, 1.0, 0.3, 4.0
+    sim = ds.EventDriven(ball(5.0, r, vx, vy, r), BOX, gravity=(0.0, -G), restitution=e, rest_speed=1.0)
+    sim.run(until=3.0)
+    ts = np.linspace(0.0, 3.0, 61)
+    f = ds.frames(sim, ts)
+    assert np.array_equal(f.positions, sim.trajectory(ts))
+    up = ts < 2 * vy / G  # the first flight, in closed form
+    assert f.positions[up, 0, 0] == pytest.approx(5.0 + vx * ts[up], rel=1e-14)
+    assert f.positions[up, 0, 1] == pytest.approx(r + vy * ts[up] - G * ts[up] ** 2 / 2, rel=1e-13, abs=1e-14)
+    assert f.velocities[up, 0, 1] == pytest.approx(vy - G * ts[up], rel=1e-13, abs=1e-13)
+    assert (f.velocities[up, 0, 0] == vx).all()
+    rest = times(sim)[-1]
+    assert sim.resting.all() and rest < 3.0
+    still = ts >= rest
+    assert (f.velocities[still] == 0.0).all() and (f.positions[still] == sim.positions).all()
+    # The same from a log streamed to disk (its header holds the gravity), read chunk by chunk.
+    path = tmp_path / "events.dse"
+    ds.EventDriven(ball(5.0, r, vx, vy, r), BOX, gravity=(0.0, -G), restitution=e, rest_speed=1.0).run(
+        until=3.0, record_to=path
+    )
+    streamed = ds.frames(path, ts)
+    assert np.array_equal(streamed.positions, f.positions) and np.array_equal(streamed.velocities, f.velocities)
+    assert np.array_equal(ds.frames(ds.read_events(path), ts).positions, f.positions)
+
+
+def test_a_replay_under_gravity_read_in_chunks_carries_each_rest_across_them():
+    from discsim.trajectory import LastRecords, replay
+
+    discs, box = ds.random_gas(30, 0.3, periodic=False, seed=5)
+    sim = ds.EventDriven(discs, box, gravity=(0.0, -20.0), restitution=0.3).run(until=3.0)
+    assert sim.counts["rests"] > 0
+    ts = np.linspace(0.0, 3.0, 31)
+    origin = LastRecords.at_start(discs, 0.0)
+    for unwrapped in (False, True):
+        chunks = np.array_split(sim.events, 40)
+        positions, velocities = replay(
+            chunks, origin, ts, box, unwrapped=unwrapped, velocities=True, gravity=sim.laws.gravity
+        )
+        assert np.array_equal(positions, sim.trajectory(ts, unwrapped=unwrapped))
+        assert np.array_equal(velocities[-1], sim.velocities)
+
+
+def test_replays_refuse_a_run_with_drag_naming_it():
+    from discsim.trajectory import flight
+
+    with pytest.raises(InvalidArgumentError, match=r"frames\(\).*drag 0.5"):
+        flight((0.0, -G), 0.5, what="frames()")
+    assert flight((0.0, -G), 0.0, what="frames()") == (0.0, -G) and flight(None, what="frames()") is None
 
 
 # --- found by review: rest and wake ---------------------------------------------------------------------------

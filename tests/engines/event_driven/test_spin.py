@@ -217,6 +217,18 @@ def test_the_spin_log_follows_the_event_log():
     assert sim.trajectory([sim.time])[0] == pytest.approx(sim.positions, rel=1e-12)  # spin moves no centre
 
 
+def test_a_rough_run_s_frames_carry_each_disc_s_spin_and_angle():
+    discs, box = gas(seed=8, periodic=False)
+    sim = ds.EventDriven(discs, box, roughness=0.6).run(events=200)
+    half = ds.EventDriven(discs, box, roughness=0.6).run(until=sim.time / 2)
+    f = ds.frames(sim, [0.0, sim.time / 2, sim.time])
+    assert (f.angles[0] == 0.0).all()  # angles count from the start (its wall hits at t = 0 done: their spins)
+    assert f.spins[1].tolist() == half.spins.tolist() and f.spins[2].tolist() == sim.spins.tolist()
+    assert f.angles[1] == pytest.approx(half.angles, rel=1e-12, abs=1e-12)
+    assert f.angles[2] == pytest.approx(sim.angles, rel=1e-12, abs=1e-12)
+    assert f.discs(1).spins.tolist() == half.spins.tolist()
+
+
 @pytest.mark.slow
 def test_a_rough_elastic_gas_shares_its_energy_equally_among_its_degrees_of_freedom():
     # beta = 1, I = m r^2 / 2: one rotational and two translational degrees of freedom per disc, so the

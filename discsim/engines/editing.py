@@ -113,7 +113,7 @@ class DiscEditing:
 
     def add_discs(self, discs: Discs) -> np.ndarray:
         """Add ``discs`` (a :class:`~discsim.model.Discs` of ``K`` discs: positions in the box, velocities, radii,
-        masses, groups) at ``time``. Returns their indices ``N, ..., N + K - 1`` ``(K,)`` int64.
+        masses, groups, spins and inertia) at ``time``. Returns their indices ``N, ..., N + K - 1`` ``(K,)`` int64.
 
         Validated as the constructor validates the discs: each new disc must lie in the box (in ``[0, width)
         x [0, height)`` when periodic), clear of the walls, the segments, every disc already there and every
@@ -170,6 +170,8 @@ class DiscEditing:
             np.concatenate([now.radii, discs.radii]),
             np.concatenate([now.masses, discs.masses]),
             np.concatenate([now.groups, discs.groups]),
+            np.concatenate([now.spins, discs.spins]),  # each disc keeps its turning (the new ones, their own)
+            np.concatenate([now.inertia, discs.inertia]),
         )
         scene = self.scene
         check_added(everyone, self.box, n, scene.segments, scene.pass_through)
@@ -215,7 +217,15 @@ class DiscEditing:
         keep = np.delete(np.arange(n), idx)
         now = self.snapshot()
         gone_positions, gone_velocities = now.positions[np.sort(idx)], now.velocities[np.sort(idx)]
-        rest = Discs(now.positions[keep], now.velocities[keep], now.radii[keep], now.masses[keep], now.groups[keep])
+        rest = Discs(
+            now.positions[keep],
+            now.velocities[keep],
+            now.radii[keep],
+            now.masses[keep],
+            now.groups[keep],
+            now.spins[keep],
+            now.inertia[keep],
+        )
         scene = self.scene
         new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
         gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()

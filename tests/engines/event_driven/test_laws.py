@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import discsim as ds
-from discsim.errors import InvalidArgumentError, JammedError
+from discsim.errors import InvalidArgumentError, JammedError, UnitsError
 
 G = 9.81
 BOX = ds.Box(10.0, 10.0)
@@ -219,6 +219,38 @@ def test_the_defaults_are_todays_physics():
 def test_bad_laws_are_refused_naming_the_argument(kwargs, name):
     with pytest.raises(InvalidArgumentError, match=name):
         ds.EventDriven(ball(5.0, 5.0), BOX, **kwargs)
+
+
+@pytest.mark.parametrize("engine", [ds.EventDriven, lambda d, b, **kw: ds.FixedStep(d, b, frame_rate=10.0, **kw)])
+def test_a_restitution_pair_of_a_group_no_disc_has_is_refused_naming_it(engine):
+    discs = ds.Discs([[2.0, 5.0], [8.0, 5.0]], [[1.0, 0.0], [-1.0, 0.0]], radii=1.0, groups=[0, 1])
+    with pytest.raises(InvalidArgumentError, match=r"restitution names the pair \(1, 2\).*group 2.*\[0, 1\]"):
+        engine(discs, BOX, restitution={(0, 1): 0.5, (2, 1): 0.3})
+    assert engine(discs, BOX, restitution={(1, 0): 0.5, (1, 1): 0.3}).laws.restitution == {(0, 1): 0.5, (1, 1): 0.3}
+
+
+@pytest.mark.parametrize("engine", [ds.EventDriven, lambda d, b, **kw: ds.FixedStep(d, b, frame_rate=10.0, **kw)])
+@pytest.mark.parametrize("gravity", [(0.0, -1e300), (1e200, 1e200), (0.0, -1e100)])
+def test_gravity_too_strong_for_the_box_is_refused_naming_it(engine, gravity):
+    # A fall across the box would reach a speed beyond discsim.model.SPEED_RANGE (or overflow on the way).
+    with pytest.raises(UnitsError, match=r"gravity .* too strong for the box 10 x 10.*SPEED_RANGE"):
+        engine(ball(5.0, 5.0), BOX, gravity=gravity)
+    strong = engine(ball(5.0, 5.0), BOX, gravity=(0.0, -1e90))  # a fall across the box: about 4e45, resolved
+    assert strong.laws.gravity == (0.0, -1e90)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=AssertionError,
+    reason="the loop's rest rule (numba/loop.py, the wall/segment resolution) zeroes the whole velocity at the "
+    "floor contact predicted at once after the edit; the fix (a sliding state) must be made in loop.py",
+)
+def test_a_disc_resting_on_the_floor_moves_when_given_a_horizontal_velocity(every_backend):
+    sim = ds.EventDriven(ball(5.0, 3.0), BOX, gravity=(0.0, -G), restitution=0.5).run(until=3.0)
+    assert sim.resting.all()
+    sim.set_velocities([0], [[1.0, 0.0]])
+    sim.run(until=4.0)
+    assert sim.positions[0, 0] == pytest.approx(6.0)  # today 5.0: the edit is undone at t = 3
 
 
 def test_a_disc_at_rest_on_a_cell_edge_falls(every_backend):

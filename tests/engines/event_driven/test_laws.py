@@ -356,6 +356,30 @@ def test_a_replay_under_gravity_read_in_chunks_carries_each_rest_across_them():
         assert np.array_equal(velocities[-1], sim.velocities)
 
 
+def test_a_periodic_fall_read_in_chunks_counts_the_box_lengths_along_the_parabolas(tmp_path):
+    from discsim.trajectory import LastRecords, replay
+
+    # Fast enough that a disc falls more than half the box between two of its records: the box lengths crossed
+    # between them must be counted along the parabola, not the straight line.
+    discs, box = ds.random_gas(40, 0.3, periodic=True, seed=5)
+    path = tmp_path / "events.dse"
+    gravity = (3.0, -1000.0)
+    sim = ds.EventDriven(discs, box, gravity=gravity).run(until=3.0, record_to=path)
+    held = ds.EventDriven(discs, box, gravity=gravity).run(until=3.0)
+    ts = np.linspace(0.0, 3.0, 31)
+    expected = held.trajectory(ts, unwrapped=True)
+    chunks = np.array_split(held.events, 40)
+    got = replay(chunks, LastRecords.at_start(discs, 0.0), ts, box, unwrapped=True, gravity=gravity)
+    assert np.array_equal(got, expected)
+    assert np.array_equal(ds.trajectory_from_events(path, ts, unwrapped=True), expected)
+    # Each chunk of the streamed log starts from each disc's last record, unwrapped along the parabolas.
+    for chunk in ds.iter_events(path, chunk=20, unwrapped=True):
+        before = chunk.before
+        at = np.array([held.trajectory([t], unwrapped=True)[0, d] for d, t in enumerate(before.times)])
+        assert before.positions + before.images * box.size == pytest.approx(at, rel=1e-12, abs=1e-9)
+    assert sim.counts == held.counts
+
+
 def test_replays_refuse_a_run_with_drag_naming_it():
     from discsim.trajectory import flight
 
@@ -438,12 +462,14 @@ def test_an_empty_restitution_table_is_elastic():
     assert sim.laws.restitution == 1.0
 
 
-def test_a_log_streamed_under_gravity_refuses_a_free_flight_replay(tmp_path):
+def test_a_log_streamed_under_gravity_replays_the_parabolas_and_the_rest(tmp_path):
     path = tmp_path / "events.dse"
-    sim = ds.EventDriven(ball(5.0, 8.0, 1.0), BOX, gravity=(0.0, -G), record=False).run(until=1.0, record_to=path)
+    laws = {"gravity": (0.0, -G), "restitution": 0.5, "rest_speed": 1.0}
+    sim = ds.EventDriven(ball(5.0, 8.0, 1.0), BOX, record=False, **laws).run(until=4.0, record_to=path)
+    held = ds.EventDriven(ball(5.0, 8.0, 1.0), BOX, **laws).run(until=4.0)
     log = ds.read_events(path)
-    assert len(log.events) == sim.counts["wall_hits"] and log.gravity == (0.0, -G)
-    with pytest.raises(InvalidArgumentError, match="gravity"):
-        ds.trajectory_from_events(path, [0.5])
-    with pytest.raises(InvalidArgumentError, match="gravity"):
-        log.trajectory([0.5])
+    assert len(log.events) == sim.counts["wall_hits"] and log.gravity == (0.0, -G) and sim.resting.all()
+    ts = np.linspace(0.0, 4.0, 41)
+    assert np.array_equal(ds.trajectory_from_events(path, ts), held.trajectory(ts))
+    assert np.array_equal(log.trajectory(ts), held.trajectory(ts))
+    assert ds.trajectory_from_events(path, [1.0])[0, 0, 1] == pytest.approx(8.0 - G / 2)

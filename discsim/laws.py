@@ -166,6 +166,12 @@ class Laws:
             gravity, e, settings.get("tc", 0.0), settings.get("rest_speed"), settings.get("roughness", -1.0)
         )
 
+    def checked(self, scene) -> Laws:
+        """These laws, checked against a :class:`~discsim.scene.Scene` (its discs' groups and its box), as an
+        engine's constructor checks them (raises as :meth:`check_scene`)."""
+        self.check_scene(scene.discs.groups, scene.box)
+        return self
+
     def check_scene(self, groups: np.ndarray, box) -> None:
         """Check the laws against the discs' ``groups`` ``(N,)`` and the ``box``, as an engine's constructor does.
 

@@ -136,8 +136,7 @@ class EventDriven(Turning, RunStops, Engine):
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
         scene = Scene(discs, box, segments, pass_through)
-        laws.check_scene(scene.discs.groups, scene.box)
-        self._configure(scene, record, queue, cell_size, backend, laws)
+        self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()
 
     def _configure(self, scene: Scene, record: bool, queue: str, cell_size, backend: str, laws: Laws) -> None:

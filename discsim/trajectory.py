@@ -234,13 +234,16 @@ class LastRecords:
             object.__setattr__(self, "still", np.zeros(len(self.times), dtype=bool))
 
     @classmethod
-    def at_start(cls, discs, start_time: float, ids=None) -> LastRecords:
-        """The discs ``discs`` (ids ``ids``, default their indices) where a log starts, at ``start_time``."""
+    def at_start(cls, discs, start_time: float, ids=None, still=None) -> LastRecords:
+        """The discs ``discs`` (ids ``ids``, default their indices) where a log starts, at ``start_time``; ``still``
+        ``(N,)`` bool: those at rest then (a log streamed from the middle of a run under gravity; default none)."""
         ids = np.arange(len(discs)) if ids is None else np.asarray(ids, dtype=np.int64)
         m = int(ids.max()) + 1 if len(ids) else 0
         out = cls._empty(m, float(start_time))
         out.positions[ids], out.velocities[ids] = discs.positions, discs.velocities
         out.radii[ids], out.masses[ids], out.groups[ids] = discs.radii, discs.masses, discs.groups
+        if still is not None:
+            out.still[ids] = np.asarray(still, dtype=bool)
         return out
 
     @classmethod
@@ -402,17 +405,39 @@ def log_start(events, discs, ids=None) -> tuple[np.ndarray, ...]:
 
 
 def positions_from_log(
-    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None, gravity=None
+    events,
+    discs,
+    box,
+    start_time: float,
+    end_time: float,
+    times,
+    *,
+    span: str,
+    unwrapped: bool,
+    ids=None,
+    gravity=None,
+    still=None,
 ):
-    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``.
+    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``
+    (``still`` ``(N,)``: those of ``discs`` at rest then, under ``gravity``; default none).
 
     Checks ``times`` first (:func:`check_times`, naming the ``span``). Returns positions ``(T, M, 2)``: one
     column per disc id (:func:`log_start`), NaN where that disc was not in the simulation.
     """
     times = check_times(times, start_time, end_time, span)
     positions, velocities, _, masses, _ = log_start(events, discs, ids)
+    still0 = None if still is None else LastRecords.at_start(discs, start_time, ids, still).grown(len(masses)).still
     return reconstruct(
-        events, positions, velocities, start_time, times, box, unwrapped=unwrapped, gravity=gravity, masses=masses
+        events,
+        positions,
+        velocities,
+        start_time,
+        times,
+        box,
+        unwrapped=unwrapped,
+        gravity=gravity,
+        masses=masses,
+        still0=still0,
     )
 
 

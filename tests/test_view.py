@@ -462,3 +462,18 @@ def test_a_streamed_run_under_gravity_is_viewed_from_its_log(tmp_path):
     from_file, from_engine = page_data(ds.view(path, path=None)), page_data(ds.view(sim, path=None))
     assert from_file["runs"][0]["gravity"] == from_engine["runs"][0]["gravity"] == [0.0, -9.81]
     assert from_file["runs"][0]["falls"] == page_data(ds.view(thrown_under_gravity(), path=None))["runs"][0]["falls"]
+
+
+def test_a_log_streamed_from_mid_run_draws_the_discs_at_rest_where_they_rest(tmp_path):
+    discs = ds.Discs(
+        [[2.0, 1.0], [6.0, 6.0], [8.5, 8.5]], [[0.0, 0.0], [-1.0, 0.0], [0.0, 0.0]], [1.0, 0.8, 0.5], groups=[0, 0, 1]
+    )
+    laws = {"gravity": (0.0, -9.81), "restitution": {(0, 0): 0.6, (0, 1): 0.6, (1, 1): 0.95}, "rest_speed": 1.0}
+    sim = ds.EventDriven(discs, ds.Box(10, 10), record=False, **laws).run(until=3.0)
+    assert sim.resting.tolist() == [True, True, False]
+    sim.run(until=4.0, record_to=tmp_path / "events.dse")
+    page = ds.view(tmp_path / "events.dse", tmp_path / "late.html")
+    times = np.linspace(3.0, 4.0, 6)
+    expected = ds.EventDriven(discs, ds.Box(10, 10), **laws).run(until=4.0).trajectory(times)
+    for k, r in enumerate(seek_all(page.path, tmp_path, times)):
+        assert_same_positions(r["positions"][0], expected[k])

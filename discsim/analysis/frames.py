@@ -235,6 +235,19 @@ def run_flight(source, engine, what: str):
     return flight(meta.get("gravity"), meta.get("drag", 0.0), what=what)
 
 
+def _start_still(source, engine) -> np.ndarray | None:
+    """``(N,)`` bool, the discs at rest where a streamed log starts (its header's ``resting``), or None: none."""
+    from discsim.io.streams import StreamedEvents, iter_events
+
+    if engine is not None:
+        if not engine.run_context.streamed:
+            return None  # a log held in memory starts where the run starts: no disc at rest
+        source = engine.run_context.stream["path"]
+    if isinstance(source, StreamedEvents):
+        return source.resting
+    return iter_events(source, partial=engine is not None).resting
+
+
 def _turning(engine, discs: Discs, start: float, times: np.ndarray):
     """``(spins, angles)`` ``(T, N)`` each at ``times`` for an engine's run (None, None where it does not say)."""
     if engine is None or engine.run_context.streamed:
@@ -280,7 +293,7 @@ def frames(source, times) -> Frames:
     gravity = run_flight(source, engine, "frames()")
     times = check_times(times, start, end, "simulated span")
     # A streamed log is read one chunk at a time, up to the last time asked: memory flat in its length.
-    origin = LastRecords.at_start(discs, start)
+    origin = LastRecords.at_start(discs, start, still=_start_still(source, engine))
     unwrapped, velocities = replay(chunks(), origin, times, box, unwrapped=True, velocities=True, gravity=gravity)
     spins, angles = _turning(engine, discs, start, times)
     return Frames(

@@ -37,7 +37,14 @@ DEFAULT_CHUNK = 65_536
 
 
 def stream_header(
-    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None, gravity=None
+    discs: Discs,
+    box: Box,
+    start_time: float,
+    run_id: str,
+    base: int,
+    ids: np.ndarray | None = None,
+    gravity=None,
+    resting=None,
 ) -> tuple[dict, dict]:
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
@@ -49,6 +56,8 @@ def stream_header(
         ids: ``(N,)`` the discs' ids (``sim.ids``), stored only when given (None: their indices).
         gravity: the run's ``(gx, gy)``, stored when given: a replay of the log then follows the parabolas
             between records (and each disc's rest).
+        resting: ``(N,)`` bool, the discs at rest at ``start_time`` (under gravity), stored when any is: a log
+            started in the middle of a run replays them at rest until their next record.
     """
     meta = {
         "kind": STREAM_KIND,
@@ -69,6 +78,8 @@ def stream_header(
     }
     if ids is not None:
         arrays["ids"] = np.asarray(ids, dtype=np.int64)
+    if gravity is not None and resting is not None and np.any(resting):
+        arrays["resting"] = np.asarray(resting, dtype=bool)
     return meta, arrays
 
 
@@ -86,6 +97,7 @@ class StreamedEvents:
         run_id: the run that wrote the log.
         ids: ``(N,)`` the ids of ``discs`` (the names the records give them), or None: their indices.
         gravity: the run's ``(gx, gy)`` if it ran under gravity (:meth:`trajectory` follows its parabolas), else None.
+        resting: ``(N,)`` bool, the ``discs`` at rest at ``start_time`` (under gravity), or None: none.
     """
 
     events: np.ndarray
@@ -96,6 +108,7 @@ class StreamedEvents:
     run_id: str
     ids: np.ndarray | None = None
     gravity: tuple | None = None
+    resting: np.ndarray | None = None
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -118,6 +131,7 @@ class StreamedEvents:
             unwrapped=unwrapped,
             ids=self.ids,
             gravity=self.gravity,
+            still=self.resting,
         )
 
 
@@ -161,8 +175,27 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
     end_time = float(stream.last.get("time", start_time))
     gravity = stream.meta.get("gravity")
     return StreamedEvents(
-        stream.records, discs, box, start_time, end_time, run_id, ids, None if gravity is None else tuple(gravity)
+        stream.records,
+        discs,
+        box,
+        start_time,
+        end_time,
+        run_id,
+        ids,
+        None if gravity is None else tuple(gravity),
+        _resting(path, stream.arrays, len(discs)),
     )
+
+
+def _resting(path, arrays, n: int) -> np.ndarray | None:
+    """The header's ``resting`` ``(N,)`` bool (None: absent, no disc at rest where the log starts), checked."""
+    resting = arrays.get("resting")
+    if resting is None:
+        return None
+    if np.shape(resting) != (n,):
+        msg = f"{path}: the event log's header has resting of shape {np.shape(resting)} for {n} discs"
+        raise CheckpointError(msg)
+    return np.asarray(resting, dtype=bool)
 
 
 def _header(path, meta, arrays) -> tuple[Discs, Box, float, str, np.ndarray | None]:
@@ -213,7 +246,8 @@ class EventChunks:
         chunk: records per chunk at most. start: the time the chunks start from (None: the log's start).
         unwrapped: the ``before`` positions are unwrapped (periodic box).
         gravity: the run's ``(gx, gy)`` from the header (None: free flight), which the unwrapped ``before``
-            positions follow between records.
+            positions follow between records. resting: ``(N,)`` bool, the ``discs`` at rest where the log starts
+            (None: none).
     """
 
     path: Path
@@ -229,9 +263,10 @@ class EventChunks:
     unwrapped: bool
     partial: bool
     gravity: tuple | None = None
+    resting: np.ndarray | None = None
 
     def __iter__(self) -> Iterator[EventChunk]:
-        carry = LastRecords.at_start(self.discs, self.start_time, self.ids)
+        carry = LastRecords.at_start(self.discs, self.start_time, self.ids, self.resting)
         walk = iter_stream(self.path, partial=self.partial)
         next(walk)  # the header
         start = -np.inf if self.start is None else self.start
@@ -329,6 +364,7 @@ def iter_events(
         unwrapped,
         partial,
         None if gravity is None else (float(gravity[0]), float(gravity[1])),
+        _resting(path, arrays, len(discs)),
     )
 
 
@@ -360,5 +396,5 @@ def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndar
     gravity = flight(meta.get("gravity"), meta.get("drag", 0.0), what=f"the replay of {str(source)!r}")
     log = iter_events(Path(source), unwrapped=unwrapped)
     times = check_times(times, log.start_time, log.end_time, "logged span")
-    origin = LastRecords.at_start(log.discs, log.start_time, log.ids)
+    origin = LastRecords.at_start(log.discs, log.start_time, log.ids, log.resting)
     return replay(log.record_arrays(), origin, times, log.box, unwrapped=unwrapped, gravity=gravity)

@@ -356,6 +356,34 @@ def test_a_replay_under_gravity_read_in_chunks_carries_each_rest_across_them():
         assert np.array_equal(velocities[-1], sim.velocities)
 
 
+def test_a_log_streamed_from_mid_run_keeps_the_discs_at_rest_where_they_rest(tmp_path):
+    # The stream starts at t = 3 with discs 0 and 1 at rest and disc 2 in flight: its header says who rests, or
+    # every replay lets discs 0 and 1 fall through the floor.
+    discs = ds.Discs(
+        [[2.0, 1.0], [6.0, 6.0], [8.5, 8.5]], [[0.0, 0.0], [-1.0, 0.0], [0.0, 0.0]], [1.0, 0.8, 0.5], groups=[0, 0, 1]
+    )
+    laws = {"gravity": (0.0, -G), "restitution": {(0, 0): 0.6, (0, 1): 0.6, (1, 1): 0.95}, "rest_speed": 1.0}
+    sim = ds.EventDriven(discs, BOX, record=False, **laws).run(until=3.0)
+    assert sim.resting.tolist() == [True, True, False]
+    path = tmp_path / "events.dse"
+    sim.run(until=4.0, record_to=path)
+    held = ds.EventDriven(discs, BOX, **laws).run(until=4.0)
+    ts = np.linspace(3.0, 4.0, 11)
+    expected = held.trajectory(ts)
+    assert (expected[:, 0] == [2.0, 1.0]).all() and len(np.unique(expected[:, 2, 1])) == len(ts)
+    # The log starts from a snapshot at t = 3: disc 2's parabola restarts there (the same to roundoff).
+    for replayed in (
+        ds.trajectory_from_events(path, ts),
+        ds.read_events(path).trajectory(ts),
+        ds.frames(path, ts).positions,
+        ds.frames(sim, ts).positions,
+    ):
+        assert np.array_equal(replayed[:, :2], expected[:, :2])
+        assert replayed[:, 2] == pytest.approx(expected[:, 2], rel=1e-14)
+    assert ds.read_events(path).resting.tolist() == [True, True, False]
+    assert next(iter(ds.iter_events(path))).before.still.tolist() == [True, True, False]
+
+
 def test_a_periodic_fall_read_in_chunks_counts_the_box_lengths_along_the_parabolas(tmp_path):
     from discsim.trajectory import LastRecords, replay
 

@@ -184,6 +184,42 @@ class Laws:
             settings.get("drag", 0.0),
         )
 
+    def checked(self, scene) -> Laws:
+        """These laws, checked against a :class:`~discsim.scene.Scene` (its discs' groups and its box), as an
+        engine's constructor checks them (raises as :meth:`check_scene`)."""
+        self.check_scene(scene.discs.groups, scene.box)
+        return self
+
+    def check_scene(self, groups: np.ndarray, box) -> None:
+        """Check the laws against the discs' ``groups`` ``(N,)`` and the ``box``, as an engine's constructor does.
+
+        Raises:
+            InvalidArgumentError: a restitution pair naming a group label that no disc has (naming the pair).
+            UnitsError: gravity so strong that a fall across the box (its longer side ``L``) would reach a speed,
+                ``sqrt(2 |g| L)``, beyond the largest that discsim resolves (:data:`discsim.model.SPEED_RANGE`).
+        """
+        from discsim.errors import UnitsError
+        from discsim.model import SPEED_RANGE
+
+        labels = sorted({int(g) for g in np.unique(groups)})
+        for (a, b), _ in self._pairs:
+            missing = [g for g in (a, b) if g not in labels]
+            if missing:
+                msg = (
+                    f"restitution names the pair {(a, b)!r}, but no disc has group {missing[0]} (groups: {labels[:20]})"
+                )
+                raise InvalidArgumentError(msg)
+        if self.falls:
+            longest = max(float(box.width), float(box.height))
+            speed = math.sqrt(2.0 * math.hypot(*self.gravity) * longest)  # inf if |g| L overflows
+            if not speed <= SPEED_RANGE[1]:
+                msg = (
+                    f"gravity {self.gravity!r} is too strong for the box {float(box.width):g} x {float(box.height):g}: "
+                    f"a fall across it would reach speed {speed:.3g}, beyond the largest discsim resolves "
+                    f"({SPEED_RANGE[1]:g}; discsim.model.SPEED_RANGE)"
+                )
+                raise UnitsError(msg)
+
     def rest_speed_for(self, radii: np.ndarray) -> float:
         """The rest speed a run of discs of ``radii`` uses (0 without gravity)."""
         if not self.falls:

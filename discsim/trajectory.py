@@ -11,12 +11,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from discsim.errors import TimeError
+from discsim.errors import InvalidArgumentError, TimeError
 from discsim.events import EventKind, added_discs
 from discsim.model import image_steps
 from discsim.physics.dynamics import advance, advance_many
 
-__all__ = ["LastRecords", "check_times", "log_start", "positions_from_log", "reconstruct", "replay"]
+__all__ = [
+    "LastRecords",
+    "check_times",
+    "falling",
+    "flight",
+    "log_start",
+    "positions_from_log",
+    "reconstruct",
+    "replay",
+    "turning_at",
+    "turning_history",
+]
+
+#: The event kinds after which a disc with velocity exactly zero has come to rest (under gravity).
+_PHYSICAL = (int(EventKind.COLLISION), int(EventKind.WALL))
 
 
 def check_times(times, start: float, end: float, span: str) -> np.ndarray:
@@ -59,6 +73,7 @@ def reconstruct(
     images0=None,
     gravity=None,
     masses=None,
+    still0=None,
     drag: float = 0.0,
 ) -> np.ndarray:
     """Exact positions of every disc at ``times`` from an initial state and a log.
@@ -82,6 +97,7 @@ def reconstruct(
             event with velocity exactly zero (the initial state and an edit always fall). A disc that an event
             stops dead while it still falls (possible only in contrived, exactly symmetric collisions) is taken at
             rest.
+        still0: ``(N,)`` bool, the discs at rest at ``time0`` (:attr:`LastRecords.still`; gravity only), default none.
         drag: the run's drag ``gamma`` (1 / time; 0: none): exponential flight between records
             (:func:`discsim.physics.dynamics.advance_many`).
 
@@ -93,10 +109,10 @@ def reconstruct(
     """
     times = np.atleast_1d(np.asarray(times, dtype=float))
     n = len(positions0)
-    falling = gravity is not None and tuple(gravity) != (0.0, 0.0)
-    disc, t_rec, state, starts, *kind = _sorted_records(events, positions0, velocities0, time0, kinds=falling)
+    under_gravity = gravity is not None and tuple(gravity) != (0.0, 0.0)
+    disc, t_rec, state, starts, *kind = _sorted_records(events, positions0, velocities0, time0, kinds=under_gravity)
     periodic = box is not None and box.periodic
-    falls = _falling(disc, state, kind[0], gravity, masses) if falling else None
+    falls = falling(disc, state, kind[0], gravity, masses, still0) if under_gravity else None
     if unwrapped and periodic and (len(state) > n or images0 is not None):
         state[:, :2] += _image_counts(disc, t_rec, state, starts, box.size, images0, gravity, falls, drag) * box.size
     out = np.empty((len(times), n, 2))
@@ -112,15 +128,22 @@ def reconstruct(
     return out
 
 
-def _falling(disc, state, kind, gravity, masses) -> np.ndarray:
+def falling(disc, state, kind, gravity, masses, still0=None) -> np.ndarray:
     """``(R,)`` bool: the records after which the disc falls (see :func:`reconstruct`): all but those of a
-    collision or wall hit that left the disc with velocity exactly zero (at rest), and the discs of infinite mass."""
-    still = (state[:, 2] == 0.0) & (state[:, 3] == 0.0)
-    physical = (kind == int(EventKind.COLLISION)) | (kind == int(EventKind.WALL))
-    moving = ~(still & physical)
+    collision or wall hit that left the disc with velocity exactly zero (at rest), the first records of the discs
+    ``still0`` (at rest where the records start), and the discs of infinite mass (NaN: a disc added later, which
+    falls)."""
+    moving = ~_rests(state, kind)
+    if still0 is not None:
+        moving &= ~((kind == -1) & np.asarray(still0, dtype=bool)[disc])
     if masses is not None:
-        moving &= np.isfinite(np.asarray(masses, dtype=float))[disc]
+        moving &= ~np.isinf(np.asarray(masses, dtype=float))[disc]
     return moving
+
+
+def _rests(state, kind) -> np.ndarray:
+    """``(R,)`` bool: the records of a collision or wall hit that left the disc with velocity exactly zero."""
+    return (state[:, 2] == 0.0) & (state[:, 3] == 0.0) & np.isin(kind, _PHYSICAL)
 
 
 def _flight(state, dt, gravity, falls, drag: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -202,6 +225,9 @@ class LastRecords:
         images: ``(M, 2)`` whole box lengths each disc has crossed since the log's start (integers as
             floats; kept when records are folded with ``unwrapped=True``, else zero): its unwrapped position
             is ``positions + images * box.size``.
+        still: ``(M,)`` bool, the discs whose last record is a collision or wall hit that left them with velocity
+            exactly zero: under gravity, at rest (they do not fall until their next record; see
+            :func:`reconstruct`). False where the log starts.
     """
 
     times: np.ndarray
@@ -211,15 +237,23 @@ class LastRecords:
     masses: np.ndarray
     groups: np.ndarray
     images: np.ndarray
+    still: np.ndarray = None  # type: ignore[assignment]  # None: none at rest (filled in by __post_init__)
+
+    def __post_init__(self) -> None:
+        if self.still is None:
+            object.__setattr__(self, "still", np.zeros(len(self.times), dtype=bool))
 
     @classmethod
-    def at_start(cls, discs, start_time: float, ids=None) -> LastRecords:
-        """The discs ``discs`` (ids ``ids``, default their indices) where a log starts, at ``start_time``."""
+    def at_start(cls, discs, start_time: float, ids=None, still=None) -> LastRecords:
+        """The discs ``discs`` (ids ``ids``, default their indices) where a log starts, at ``start_time``; ``still``
+        ``(N,)`` bool: those at rest then (a log streamed from the middle of a run under gravity; default none)."""
         ids = np.arange(len(discs)) if ids is None else np.asarray(ids, dtype=np.int64)
         m = int(ids.max()) + 1 if len(ids) else 0
         out = cls._empty(m, float(start_time))
         out.positions[ids], out.velocities[ids] = discs.positions, discs.velocities
         out.radii[ids], out.masses[ids], out.groups[ids] = discs.radii, discs.masses, discs.groups
+        if still is not None:
+            out.still[ids] = np.asarray(still, dtype=bool)
         return out
 
     @classmethod
@@ -232,6 +266,7 @@ class LastRecords:
             np.full(m, np.nan),
             np.zeros(m, dtype=np.int64),
             np.zeros((m, 2)),
+            np.zeros(m, dtype=bool),
         )
 
     def __len__(self) -> int:
@@ -248,7 +283,16 @@ class LastRecords:
         )
 
     def _arrays(self) -> tuple[np.ndarray, ...]:
-        return self.times, self.positions, self.velocities, self.radii, self.masses, self.groups, self.images
+        return (
+            self.times,
+            self.positions,
+            self.velocities,
+            self.radii,
+            self.masses,
+            self.groups,
+            self.images,
+            self.still,
+        )
 
     def _after_in_order(self, records: np.ndarray) -> LastRecords:
         """:meth:`after` for records in time order, none before these records' times: a disc's last record
@@ -259,6 +303,8 @@ class LastRecords:
         pair = records["j"] >= 0
         np.maximum.at(as_j, records["j"][pair], rows[pair])
         times, positions, velocities = self.times.copy(), self.positions.copy(), self.velocities.copy()
+        still = self.still.copy()
+        physical = np.isin(records["kind"], _PHYSICAL)
         for last, chosen, names in (
             (as_i, as_i > as_j, ("xi", "yi", "vxi", "vyi")),
             (as_j, as_j > as_i, ("xj", "yj", "vxj", "vyj")),
@@ -267,15 +313,17 @@ class LastRecords:
             times[chosen] = records["time"][k]
             positions[chosen] = np.column_stack([records[names[0]][k], records[names[1]][k]])
             velocities[chosen] = np.column_stack([records[names[2]][k], records[names[3]][k]])
+            still[chosen] = physical[k] & (velocities[chosen] == 0.0).all(axis=1)
         radii, masses, groups = self.radii.copy(), self.masses.copy(), self.groups.copy()
-        return LastRecords(times, positions, velocities, radii, masses, groups, self.images)
+        return LastRecords(times, positions, velocities, radii, masses, groups, self.images, still)
 
-    def after(self, records: np.ndarray, box=None, *, unwrapped: bool = False) -> LastRecords:
+    def after(self, records: np.ndarray, box=None, *, unwrapped: bool = False, gravity=None) -> LastRecords:
         """These records followed by ``records`` (:data:`EVENT_DTYPE`, later in the log): a new object.
 
         A disc's last record is its latest in time (then in log order), as :func:`reconstruct` takes it;
         ``ADD`` records bring new ids (their radius, mass and group), ``REMOVE`` records make a disc NaN.
-        ``unwrapped`` (with a periodic ``box``) keeps the positions continuous across the edges.
+        ``unwrapped`` (with a periodic ``box``) keeps the positions continuous across the edges, along the
+        parabolas of the run's ``gravity`` ``(gx, gy)`` (None: straight lines).
         """
         if not len(records):
             return self
@@ -288,11 +336,19 @@ class LastRecords:
         if not shifts and times[0] >= np.max(base.times, initial=-np.inf) and (np.diff(times) >= 0).all():
             out = base._after_in_order(records)
         else:  # out of time order (or the box lengths crossed wanted): sort every disc's records
-            disc, t_rec, state, starts = _sorted_records(records, base.positions, base.velocities, base.times)
+            disc, t_rec, state, starts, kind = _sorted_records(
+                records, base.positions, base.velocities, base.times, kinds=True
+            )
             last = starts[1:] - 1
             images = base.images
             if shifts:
-                images = _image_counts(disc, t_rec, state, starts, box.size, base.images)[last]
+                falls = (
+                    falling(disc, state, kind, gravity, base.masses, base.still)
+                    if gravity is not None and tuple(gravity) != (0.0, 0.0)
+                    else None
+                )
+                images = _image_counts(disc, t_rec, state, starts, box.size, base.images, gravity, falls)[last]
+            still = np.where(kind[last] == -1, base.still, _rests(state[last], kind[last]))
             out = LastRecords(
                 t_rec[last].copy(),
                 state[last, :2].copy(),
@@ -301,6 +357,7 @@ class LastRecords:
                 base.masses.copy(),
                 base.groups.copy(),
                 images,
+                still,
             )
         if len(added):
             out.radii[added], out.masses[added], out.groups[added] = radii, masses, groups
@@ -358,23 +415,45 @@ def log_start(events, discs, ids=None) -> tuple[np.ndarray, ...]:
 
 
 def positions_from_log(
-    events, discs, box, start_time: float, end_time: float, times, *, span: str, unwrapped: bool, ids=None,
-    gravity=None, drag: float = 0.0,
-):  # fmt: skip
-    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``.
+    events,
+    discs,
+    box,
+    start_time: float,
+    end_time: float,
+    times,
+    *,
+    span: str,
+    unwrapped: bool,
+    ids=None,
+    gravity=None,
+    still=None,
+    drag: float = 0.0,
+):
+    """:func:`reconstruct` for a log covering ``[start_time, end_time]`` from ``discs`` (ids ``ids``) at ``start_time``
+    (``still`` ``(N,)``: those of ``discs`` at rest then, under ``gravity``; default none; ``drag``: the run's).
 
     Checks ``times`` first (:func:`check_times`, naming the ``span``). Returns positions ``(T, M, 2)``: one
     column per disc id (:func:`log_start`), NaN where that disc was not in the simulation.
     """
     times = check_times(times, start_time, end_time, span)
     positions, velocities, _, masses, _ = log_start(events, discs, ids)
+    still0 = None if still is None else LastRecords.at_start(discs, start_time, ids, still).grown(len(masses)).still
     return reconstruct(
-        events, positions, velocities, start_time, times, box, unwrapped=unwrapped, gravity=gravity, masses=masses,
+        events,
+        positions,
+        velocities,
+        start_time,
+        times,
+        box,
+        unwrapped=unwrapped,
+        gravity=gravity,
+        masses=masses,
+        still0=still0,
         drag=drag,
-    )  # fmt: skip
+    )
 
 
-def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, velocities: bool = False):
+def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, velocities: bool = False, gravity=None):
     """Exact positions (and velocities) at ``times`` from where a log stands and the records that follow it.
 
     Reads ``chunks`` (an iterable of :data:`EVENT_DTYPE` arrays in time order, e.g. a streamed log read chunk
@@ -389,6 +468,8 @@ def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, v
         box: the box; positions are wrapped into a periodic one unless ``unwrapped``.
         unwrapped: follow each disc across the periodic edges (from ``start.images``).
         velocities: also return the velocities.
+        gravity: the run's ``(gx, gy)`` (None: free flight): between records a disc falls along a parabola
+            unless at rest (see :func:`reconstruct`), and its velocity changes by ``g`` times the time since.
 
     Returns:
         positions ``(T, M, 2)`` (and velocities ``(T, M, 2)``): ``M`` disc ids, those known up to the last
@@ -406,11 +487,11 @@ def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, v
         k = len(wanted) if following is None else int(np.searchsorted(wanted, following["time"].min(), side="left"))
         if k > done:
             records = current if current is not None else np.zeros(0, dtype=carry.times.dtype)
-            parts.append(_evaluate(records, carry, wanted[done:k], box, unwrapped, velocities))
+            parts.append(_evaluate(records, carry, wanted[done:k], box, unwrapped, velocities, gravity))
             done = k
         if current is None or done == len(wanted):
             break
-        carry = carry.after(current, box, unwrapped=unwrapped)
+        carry = carry.after(current, box, unwrapped=unwrapped, gravity=gravity)
         current = following
     m = max((p.shape[1] for p, _ in parts), default=len(start))
     positions = np.full((len(times), m, 2), np.nan)
@@ -424,20 +505,118 @@ def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, v
     return (positions, speeds) if velocities else positions
 
 
-def _evaluate(records, carry: LastRecords, times, box, unwrapped: bool, velocities: bool):
+def _evaluate(records, carry: LastRecords, times, box, unwrapped: bool, velocities: bool, gravity=None):
     """Positions (and velocities) ``(T, M, 2)`` at sorted ``times`` from ``carry`` and one chunk of ``records``."""
     if len(records):
         carry = carry.grown(int(max(records["i"].max(), records["j"].max())) + 1)
     positions = reconstruct(
-        records, carry.positions, carry.velocities, carry.times, times, box, unwrapped=unwrapped, images0=carry.images
+        records,
+        carry.positions,
+        carry.velocities,
+        carry.times,
+        times,
+        box,
+        unwrapped=unwrapped,
+        images0=carry.images,
+        gravity=gravity,
+        masses=carry.masses,
+        still0=carry.still,
     )
     if not velocities:
         return positions, None
-    _, t_rec, state, starts = _sorted_records(records, carry.positions, carry.velocities, carry.times)
+    disc, t_rec, state, starts, kind = _sorted_records(
+        records, carry.positions, carry.velocities, carry.times, kinds=True
+    )
+    under_gravity = gravity is not None and tuple(gravity) != (0.0, 0.0)
+    falls = falling(disc, state, kind, gravity, carry.masses, carry.still) if under_gravity else None
     first = starts[:-1]
     speeds = np.empty_like(positions)
     for k, t in enumerate(times.tolist()):
         # Each disc's records are in time order, so those at or before t are a prefix of its own.
         done = np.add.reduceat((t_rec <= t).astype(np.int64), first) if len(first) else first
-        speeds[k] = state[first + np.maximum(done, 1) - 1, 2:]
+        last = first + np.maximum(done, 1) - 1
+        speeds[k] = state[last, 2:]
+        if falls is not None:  # v + g dt while falling (advance's arithmetic)
+            dt = np.where(falls[last], t - t_rec[last], 0.0)
+            speeds[k] = np.column_stack([speeds[k, :, 0] + gravity[0] * dt, speeds[k, :, 1] + gravity[1] * dt])
     return positions, speeds
+
+
+def flight(gravity=None, drag=0.0, *, what: str):
+    """The gravity ``(gx, gy)`` (or None) a replay of a run's log takes, refusing the laws it cannot replay.
+
+    Between records a disc flies straight, or falls along a parabola under ``gravity`` (:func:`reconstruct`);
+    a run with linear drag (``drag`` nonzero: exponential flight) is not replayed yet.
+
+    Raises:
+        InvalidArgumentError: for a nonzero ``drag``, naming ``what`` and the value.
+    """
+    if drag is not None and float(drag) != 0.0:
+        msg = (
+            f"{what} replays free flight and parabolas between events, and this run has drag {float(drag)!r} "
+            "(exponential flight), which it does not replay yet: use sim.trajectory(times), or sample the run "
+            "with ds.Sampler(dt) while it runs"
+        )
+        raise InvalidArgumentError(msg)
+    if gravity is None or tuple(float(g) for g in gravity) == (0.0, 0.0):
+        return None
+    return (float(gravity[0]), float(gravity[1]))
+
+
+def turning_history(events, spin_events, spins0, time0: float, angles0=None) -> tuple[np.ndarray, ...]:
+    """Every disc's spin changes from a log and its spins: each disc's spin and angle after each change.
+
+    Args:
+        events: :data:`EVENT_DTYPE` records in time order, naming discs ``0 .. N - 1`` (and no later ones).
+        spin_events: :data:`~discsim.events.SPIN_DTYPE` rows, the spins after each collision and wall hit of
+            ``events``, in order (``sim.spin_events`` of a rough run); None: spins never change (smooth discs).
+        spins0: ``(N,)`` the spins at ``time0``, where the log starts. angles0: ``(N,)`` the angles then
+            (default zero: angles count from the run's start).
+
+    Returns:
+        ``(starts (N + 1,), times (H,), spins (H,), angles (H,))``: disc ``d`` owns rows ``starts[d]:starts[d + 1]``
+        (the first at ``time0``), in time then log order; ``angles`` each row's angle at its time, summed in
+        order as the engine turns a disc (``angle += spin * (now - then)`` at each of its collisions).
+
+    Raises:
+        ValueError: if ``spin_events`` does not hold one row per collision and wall hit of ``events``.
+    """
+    spins0 = np.asarray(spins0, dtype=float)
+    n = len(spins0)
+    discs, t_recs, seqs, spins = [np.arange(n)], [np.full(n, float(time0))], [np.full(n, -1)], [spins0]
+    if spin_events is not None and len(events):
+        rows = np.flatnonzero(np.isin(events["kind"], _PHYSICAL))
+        if len(rows) != len(spin_events) or not np.array_equal(events["time"][rows], spin_events["time"]):
+            msg = f"{len(spin_events)} spin rows for {len(rows)} collisions and wall hits in the log"
+            raise ValueError(msg)
+        pair = events["j"][rows] >= 0
+        discs += [events["i"][rows], events["j"][rows][pair]]
+        t_recs += [events["time"][rows], events["time"][rows][pair]]
+        seqs += [rows, rows[pair]]
+        spins += [spin_events["wi"], spin_events["wj"][pair]]
+    disc, t_rec, seq, spin = (np.concatenate(a) for a in (discs, t_recs, seqs, spins))
+    order = np.lexsort((seq, t_rec, disc))
+    disc, t_rec, spin = disc[order], t_rec[order], spin[order]
+    starts = np.searchsorted(disc, np.arange(n + 1))
+    angles = np.empty(len(t_rec))
+    first = np.zeros(n) if angles0 is None else np.asarray(angles0, dtype=float)
+    for d in range(n):
+        lo, hi = starts[d], starts[d + 1]
+        steps = spin[lo : hi - 1] * (t_rec[lo + 1 : hi] - t_rec[lo : hi - 1])
+        angles[lo:hi] = np.cumsum(np.concatenate([[first[d]], steps]))  # (a0 + s1) + s2 ...: the engine's order
+    return starts, t_rec, spin, angles
+
+
+def turning_at(history, times) -> tuple[np.ndarray, np.ndarray]:
+    """Spins and angles ``(T, N)`` each at ``times`` ``(T,)`` from a :func:`turning_history` (a change exactly at a
+    time counts as done): the last change's spin, and its angle plus the spin times the time since."""
+    starts, t_rec, spin, angle = history
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    n = len(starts) - 1
+    spins, angles = np.empty((len(times), n)), np.empty((len(times), n))
+    for d in range(n):
+        lo, hi = starts[d], starts[d + 1]
+        k = np.maximum(lo + np.searchsorted(t_rec[lo:hi], times, side="right") - 1, lo)
+        spins[:, d] = spin[k]
+        angles[:, d] = angle[k] + spin[k] * (times - t_rec[k])
+    return spins, angles

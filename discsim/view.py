@@ -3,12 +3,15 @@
 :func:`view` writes a single HTML file (no network: the script, the style and the data are inline) that
 replays a run of either engine, or several side by side (PIT against PIC), at any playback speed and frame
 rate, with play, pause, step, a time scrubber, discs coloured by disc, group or speed, and the exact
-contacts marked. Between events discs fly straight, so the page rebuilds every position exactly as
-:func:`discsim.trajectory.reconstruct` does, with the same floating-point operations (the same numbers, bit
-for bit): it holds the discs' state where the replay starts and each disc's state after each of its events.
+contacts marked. Between events discs fly straight, or fall along exact parabolas under gravity (a disc at
+rest stays put), so the page rebuilds every position exactly as :func:`discsim.trajectory.reconstruct` does,
+with the same floating-point operations (the same numbers, bit for bit): it holds the discs' state where the
+replay starts and each disc's state after each of its events. Where the run says how its discs turn (an
+engine's spins, rough discs' spins after each collision), a radius line on each disc shows its angle.
 
 In the page, ``window.discsim`` is a small API for scripts and tests: ``seek(t)``, ``time()``,
-``positions(panel)`` (the centres last drawn, ``(N, 2)`` as nested lists), ``play()``, ``pause()``,
+``positions(panel)`` (the centres last drawn, ``(N, 2)`` as nested lists), ``angles(panel)`` (the angles of
+the marks last drawn, ``(N,)``, or null where the run does not say how its discs turn), ``play()``, ``pause()``,
 ``step(frames)``, ``nextEvent()``, ``previousEvent()``, ``setSpeed(s)``, ``setFps(f)``, ``setColour(mode)``.
 A page opened as ``view.html#t=1.25`` starts at that time.
 
@@ -34,8 +37,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import ADD, COLLISION, EVENT_DTYPE
-from discsim.trajectory import LastRecords
+from discsim.events import ADD, COLLISION, EVENT_DTYPE, EventKind
+from discsim.trajectory import LastRecords, falling, flight, turning_history
 
 if TYPE_CHECKING:
     from discsim.model import Box
@@ -70,6 +73,8 @@ class _Run:
     end_time: float
     chunks: Callable[[], Iterable[np.ndarray]]
     dt: float | None
+    gravity: tuple[float, float] | None = None
+    turning: tuple | None = None  # a turning_history of the discs by id, or None: the page draws no marks
 
 
 @dataclass(frozen=True)
@@ -83,15 +88,32 @@ class _Span:
 # --- reading the sources ---------------------------------------------------------------------------------
 
 
+def _engine_flight(sim, name: str):
+    laws = getattr(sim, "laws", None)
+    return flight(getattr(laws, "gravity", None), getattr(laws, "drag", 0.0), what=f"the viewer of this {name}")
+
+
+def _engine_turning(sim, events: np.ndarray, discs, ids) -> tuple | None:
+    """A :func:`~discsim.trajectory.turning_history` of an engine's discs by id (None: no disc turns, or the
+    spins after its collisions are not held). A disc added during the run starts without spin in it (the log's
+    ``ADD`` records hold no spin)."""
+    laws = getattr(sim, "laws", None)
+    rough = bool(getattr(laws, "rough", False))
+    if not rough and not np.any(discs.spins):
+        return None
+    ids = np.arange(len(discs)) if ids is None else np.asarray(ids)
+    top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
+    spins0 = np.zeros(max(top, int(ids.max()) + 1 if len(ids) else 0))
+    spins0[ids] = discs.spins
+    try:
+        return turning_history(events, sim.spin_events if rough else None, spins0, float(sim.start_time))
+    except (AttributeError, ValueError):  # no spins after the log's collisions (e.g. a checkpoint without them)
+        return None
+
+
 def _from_engine(sim, label: str | None) -> _Run:
     name = type(sim).__name__
-    laws = getattr(sim, "laws", None)
-    if laws is not None and laws.falls:
-        msg = (
-            f"cannot view this {name} yet: the page replays free flight between events, and this run is under "
-            f"gravity {laws.gravity} (plot its exact states with sim.trajectory(times) and discsim.plot instead)"
-        )
-        raise InvalidArgumentError(msg)
+    gravity = _engine_flight(sim, name)
     context = getattr(sim, "run_context", None)
     stream = None if context is None else context.stream
     if stream is not None:  # the run streamed its log to disk: replay the file, with the engine's scene
@@ -110,6 +132,7 @@ def _from_engine(sim, label: str | None) -> _Run:
         raise InvalidArgumentError(msg)
     discs, ids = sim.run_context.log_origin(sim.discs) if context is not None else (sim.discs, None)
     dt = getattr(sim, "dt", None)
+    turning = _engine_turning(sim, events, discs, ids)
     return _Run(
         label=label or name,
         engine=name,
@@ -120,40 +143,48 @@ def _from_engine(sim, label: str | None) -> _Run:
         end_time=float(sim.time),
         chunks=lambda: iter([events]),
         dt=float(dt) if dt else None,
+        gravity=gravity,
+        turning=turning,
     )
 
 
 def _from_stream(log, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
     """A run from the :class:`~discsim.io.streams.StreamedEvents` of :func:`discsim.read_events` (in memory)."""
     events = log.events
+    gravity = flight(log.gravity, getattr(log, "drag", 0.0), what=f"the viewer of {label!r}")
     return _Run(
         label=label,
         engine=engine,
         box=log.box,
         segments=tuple(segments),
-        origin=LastRecords.at_start(log.discs, float(log.start_time), log.ids),
+        origin=LastRecords.at_start(log.discs, float(log.start_time), log.ids, log.resting),
         start_time=float(log.start_time),
         end_time=float(log.end_time),
         chunks=lambda: iter([events]),
         dt=dt,
+        gravity=gravity,
     )
 
 
 def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
     """A run from a streamed log on disk, read chunk by chunk when the page is made (never whole)."""
+    from discsim.io.container import stream_index
     from discsim.io.streams import iter_events
 
     log = iter_events(path, partial=True)
+    meta = stream_index(path, partial=True)[0]
+    gravity = flight(meta.get("gravity"), meta.get("drag", 0.0), what=f"the viewer of {str(path)!r}")
     return _Run(
         label=label,
         engine=engine,
         box=log.box,
         segments=tuple(segments),
-        origin=LastRecords.at_start(log.discs, log.start_time, log.ids),
+        origin=LastRecords.at_start(log.discs, log.start_time, log.ids, log.resting),
         start_time=log.start_time,
         end_time=log.end_time,
         chunks=log.record_arrays,
         dt=dt,
+        gravity=gravity,
     )
 
 
@@ -261,12 +292,14 @@ def _read_span(run: _Run, t0: float, t1: float, limit: int) -> tuple[_Span, bool
 def _records(span: _Span, t0: float):
     """Each disc's state records from ``t0`` on, as :func:`discsim.trajectory.reconstruct` orders them.
 
-    Returns ``(starts (M + 1,), times (R,), states (R, 4), partners (R,))``: disc id ``d`` owns records
+    Returns ``(starts (M + 1,), times (R,), states (R, 4), partners (R,), kinds (R,))``: disc id ``d`` owns records
     ``starts[d]:starts[d + 1]``, sorted by time then log order; a record holds ``x, y, vx, vy`` after the
     event at ``times`` (NaN while the disc is not there: before its ``ADD`` record, from its ``REMOVE``
     record on); ``partners`` is -2 for the disc's last record before ``t0`` (or where the log starts), -1 for
-    a wall hit or a change, else the other disc. A disc keeps its last record at or before ``t0``, so that
-    positions in the span come from the same records, and the same arithmetic, as ``trajectory()``.
+    a wall hit or a change, else the other disc; ``kinds`` each record's event kind (-1 for the first, and
+    :data:`~discsim.events.EventKind.WALL` for a first record at rest: :attr:`LastRecords.still`). A disc keeps
+    its last record at or before ``t0``, so that positions in the span come from the same records, and the same
+    arithmetic, as ``trajectory()``.
     """
     events = span.events
     top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
@@ -278,6 +311,7 @@ def _records(span: _Span, t0: float):
     times = np.concatenate([before.times, events["time"], ev["time"]])
     seq = np.concatenate([np.full(n, -1), np.arange(len(events)), pair])
     partner = np.concatenate([np.full(n, -2), events["j"], ev["i"]])
+    kind = np.concatenate([np.where(before.still, int(EventKind.WALL), -1), events["kind"], ev["kind"]])
     states = np.vstack(
         [
             np.hstack([before.positions, before.velocities]),
@@ -286,14 +320,14 @@ def _records(span: _Span, t0: float):
         ]
     )
     order = np.lexsort((seq, times, disc))  # by disc, then time, then log order
-    disc, times, partner, states = disc[order], times[order], partner[order], states[order]
+    disc, times, partner, states, kind = disc[order], times[order], partner[order], states[order], kind[order]
     # Drop a record when the same disc has a later one still at or before t0.
     superseded = np.zeros(len(disc), dtype=bool)
     superseded[:-1] = (disc[1:] == disc[:-1]) & (times[1:] <= t0)
     keep = ~superseded
-    disc, times, partner, states = disc[keep], times[keep], partner[keep], states[keep]
+    disc, times, partner, states, kind = disc[keep], times[keep], partner[keep], states[keep], kind[keep]
     starts = np.searchsorted(disc, np.arange(n + 1))
-    return starts, times, states, partner
+    return starts, times, states, partner, kind
 
 
 def _discs_of(span: _Span) -> LastRecords:
@@ -318,9 +352,32 @@ def _span(runs: list[_Run], start, until) -> tuple[float, float]:
     return t0, t1
 
 
+def _turning_records(history: tuple, starts: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """``(R, 2)``: each record's spin and angle at its time (records of ``_records``; a disc the history does not
+    know: no spin, angle 0)."""
+    h_starts, h_times, h_spins, h_angles = history
+    out = np.zeros((len(times), 2))
+    for d in range(min(len(starts), len(h_starts)) - 1):
+        lo, hi, a, b = starts[d], starts[d + 1], h_starts[d], h_starts[d + 1]
+        if lo == hi:
+            continue
+        k = np.maximum(a + np.searchsorted(h_times[a:b], times[lo:hi], side="right") - 1, a)
+        out[lo:hi, 0] = h_spins[k]
+        out[lo:hi, 1] = h_angles[k] + h_spins[k] * (times[lo:hi] - h_times[k])
+    return out
+
+
 def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict:
-    starts, times, states, partners = _records(span, t0)
+    starts, times, states, partners, kinds = _records(span, t0)
     discs = _discs_of(span)
+    disc = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
+    # Under gravity a record's disc falls after it, unless it came to rest there or cannot move (obstacle).
+    falls = (
+        falling(disc, states, kinds, run.gravity, discs.masses)
+        if run.gravity is not None
+        else np.zeros(len(times), dtype=bool)
+    )
+    turning = None if run.turning is None else _turning_records(run.turning, starts, times)
     box = run.box
     ev = span.events
     contacts = ev[(ev["kind"] == COLLISION) & (ev["time"] >= t0) & (ev["time"] <= t1)]
@@ -341,6 +398,9 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
         "times": _b64(times, "<f8"),
         "states": _b64(states, "<f8"),
         "partners": _b64(partners, "<i4"),
+        "gravity": None if run.gravity is None else list(run.gravity),
+        "falls": _b64(falls, "u1"),
+        "turning": None if turning is None else _b64(turning, "<f8"),
         "contact_times": _b64(contacts["time"], "<f8"),
         "contact_pairs": _b64(np.column_stack([contacts["i"], contacts["j"]]), "<i4"),
         "max_speed": float(np.quantile(speeds, 0.99)) if len(speeds) else 0.0,  # the fastest 1% saturate

@@ -8,6 +8,7 @@ no Chromium binary is found.
 
 from __future__ import annotations
 
+import base64
 import html
 import json
 import os
@@ -384,3 +385,95 @@ setTimeout(() => {
     assert out["time"] > 0.05 and out["box"] == pytest.approx(out["time"], rel=1e-9)
     assert out["clocks"] == [f"t = {out['time']:.4f}"] * 2
     assert out["zoom"] == 4 and "zoom 4x" in out["zoomed"] and out["unzoomed"] == 1
+
+
+# --- under gravity, and rough discs that spin (issue 27) --------------------------------------------------
+
+
+def page_data(page) -> dict:
+    found = re.search(r'<script type="application/json" id="ds-data">(.*?)</script>', page.html, re.S)
+    assert found
+    return json.loads(found.group(1).replace("<\\/", "</"))
+
+
+def thrown_under_gravity():
+    discs = ds.Discs(
+        [[2.0, 1.5], [6.0, 6.0], [5.0, 2.0]],
+        [[1.5, 6.0], [-1.0, 0.0], [0.0, 0.0]],
+        radii=[1.0, 0.8, 0.5],
+        masses=[1.0, 1.0, np.inf],
+    )
+    return ds.EventDriven(discs, ds.Box(10, 10), gravity=(0.0, -9.81), restitution=0.6, rest_speed=1.0).run(until=6.0)
+
+
+def test_the_page_gets_the_gravity_and_each_record_s_fall_and_turning():
+    sim = thrown_under_gravity()
+    (run,) = page_data(ds.view(sim, path=None))["runs"]
+    assert run["gravity"] == [0.0, -9.81] and run["turning"] is None
+    falls = np.frombuffer(base64.b64decode(run["falls"]), dtype=np.uint8)
+    starts = np.frombuffer(base64.b64decode(run["starts"]), dtype=np.int32)
+    assert falls[starts[2]] == 0  # the obstacle never falls
+    assert falls[starts[0] : starts[1]].any() and not falls[starts[1] - 1]  # disc 0 falls, then rests
+    rough = ds.EventDriven(*ds.random_gas(12, 0.3, seed=4), roughness=0.5).run(until=1.0)
+    (run,) = page_data(ds.view(rough, path=None))["runs"]
+    assert run["gravity"] is None and run["turning"] is not None
+
+
+def test_the_page_draws_parabolas_and_rest_where_trajectory_puts_them(tmp_path):
+    sim = thrown_under_gravity()
+    assert sim.resting[:2].all()
+    page = ds.view(sim, tmp_path / "gravity.html")
+    events = sim.events["time"]
+    times = np.unique(np.concatenate([np.linspace(0.0, 6.0, 37), events, events + 1e-6]))
+    times = times[times <= 6.0]
+    expected = sim.trajectory(times)
+    for k, r in enumerate(seek_all(page.path, tmp_path, times)):
+        (drawn,) = r["positions"]
+        assert_same_positions(drawn, expected[k])
+    # A window that starts after both discs came to rest keeps them there.
+    late = ds.view(sim, tmp_path / "late.html", start=5.0)
+    (r,) = seek_all(late.path, tmp_path, [5.5])
+    assert_same_positions(r["positions"][0], sim.trajectory([5.5])[0])
+
+
+def test_the_page_marks_each_disc_s_angle_as_frames_give_it(tmp_path):
+    sim = ds.EventDriven(*ds.random_gas(20, 0.3, seed=4), roughness=0.5).run(until=3.0)
+    assert sim.counts["collisions"] > 5
+    page = ds.view(sim, tmp_path / "rough.html", start=0.5)
+    times = [0.5, 1.7, 3.0]
+    script = (
+        "const out = []; for (const t of TIMES) { discsim.seek(t); out.push(discsim.angles(0)); }"
+        "document.getElementById('ds-readout').textContent = JSON.stringify(out);"
+    ).replace("TIMES", json.dumps(times))
+    drawn = drive(page.path, tmp_path, script)
+    expected = ds.frames(sim, times).angles
+    np.testing.assert_allclose(np.array(drawn), expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(drawn[-1], sim.angles, rtol=1e-12, atol=1e-12)
+    smooth = ds.view(ds.EventDriven(*ds.random_gas(20, 0.3, seed=4)).run(until=1.0), tmp_path / "smooth.html")
+    script = "document.getElementById('ds-readout').textContent = JSON.stringify({a: discsim.angles(0)});"
+    assert drive(smooth.path, tmp_path, script)["a"] is None  # no disc turns: no marks
+
+
+def test_a_streamed_run_under_gravity_is_viewed_from_its_log(tmp_path):
+    discs = thrown_under_gravity().discs
+    path = tmp_path / "events.dse"
+    sim = ds.EventDriven(discs, ds.Box(10, 10), gravity=(0.0, -9.81), restitution=0.6, rest_speed=1.0, record=False)
+    sim.run(until=6.0, record_to=path)
+    from_file, from_engine = page_data(ds.view(path, path=None)), page_data(ds.view(sim, path=None))
+    assert from_file["runs"][0]["gravity"] == from_engine["runs"][0]["gravity"] == [0.0, -9.81]
+    assert from_file["runs"][0]["falls"] == page_data(ds.view(thrown_under_gravity(), path=None))["runs"][0]["falls"]
+
+
+def test_a_log_streamed_from_mid_run_draws_the_discs_at_rest_where_they_rest(tmp_path):
+    discs = ds.Discs(
+        [[2.0, 1.0], [6.0, 6.0], [8.5, 8.5]], [[0.0, 0.0], [-1.0, 0.0], [0.0, 0.0]], [1.0, 0.8, 0.5], groups=[0, 0, 1]
+    )
+    laws = {"gravity": (0.0, -9.81), "restitution": {(0, 0): 0.6, (0, 1): 0.6, (1, 1): 0.95}, "rest_speed": 1.0}
+    sim = ds.EventDriven(discs, ds.Box(10, 10), record=False, **laws).run(until=3.0)
+    assert sim.resting.tolist() == [True, True, False]
+    sim.run(until=4.0, record_to=tmp_path / "events.dse")
+    page = ds.view(tmp_path / "events.dse", tmp_path / "late.html")
+    times = np.linspace(3.0, 4.0, 6)
+    expected = ds.EventDriven(discs, ds.Box(10, 10), **laws).run(until=4.0).trajectory(times)
+    for k, r in enumerate(seek_all(page.path, tmp_path, times)):
+        assert_same_positions(r["positions"][0], expected[k])

@@ -3,7 +3,10 @@
 // Each disc has a list of state records (time, x, y, vx, vy): where the replay starts, then after each of its
 // events. Between records a disc flies straight, so its position at time t is that of its last record at or
 // before t plus velocity times the time since, wrapped into a periodic box: the same operations, in the same
-// order, as discsim.trajectory.reconstruct, so the page draws the numbers trajectory() gives. A disc whose
+// order, as discsim.trajectory.reconstruct, so the page draws the numbers trajectory() gives. Under gravity
+// (g) a record whose disc falls after it (falls[k]: not at rest, not an obstacle) gives x + (v + g dt / 2) dt,
+// discsim.physics.dynamics.advance's arithmetic. Where the run says how its discs turn, each record also holds
+// the disc's spin and angle (turning[2k], turning[2k + 1]), and a radius line on the disc shows its angle. A disc whose
 // state is NaN (before its ADD record, from its REMOVE record on: add_discs / remove_discs) is not drawn.
 "use strict";
 (function () {
@@ -45,11 +48,14 @@
       groups: decode(r.groups, Int32Array), starts: decode(r.starts, Int32Array),
       times: decode(r.times, Float64Array), states: decode(r.states, Float64Array),
       partners: decode(r.partners, Int32Array), maxSpeed: r.max_speed,
+      gravity: r.gravity || null, falls: decode(r.falls, Uint8Array),
+      turning: r.turning ? decode(r.turning, Float64Array) : null,
       contactTimes: decode(r.contact_times, Float64Array), contactPairs: decode(r.contact_pairs, Int32Array),
     };
     run.x = new Float64Array(run.n);
     run.y = new Float64Array(run.n);
     run.rec = new Int32Array(run.n);
+    run.angle = new Float64Array(run.n);
     run.drawnTime = NaN;
     return run;
   });
@@ -66,22 +72,40 @@
     return Math.max(first, lo - 1);
   }
 
-  // Every disc's position at time t into run.x, run.y (and its record into run.rec).
+  // The centre t after record k's time (unwrapped): straight, or along the parabola while the disc falls.
+  function centre(run, k, t) {
+    const s = run.states, dt = t - run.times[k];
+    if (run.gravity && run.falls[k]) {
+      const gx = run.gravity[0], gy = run.gravity[1];
+      return [s[4 * k] + (s[4 * k + 2] + 0.5 * gx * dt) * dt, s[4 * k + 1] + (s[4 * k + 3] + 0.5 * gy * dt) * dt];
+    }
+    return [s[4 * k] + s[4 * k + 2] * dt, s[4 * k + 1] + s[4 * k + 3] * dt];
+  }
+
+  // The velocity at t after record k (it changes by g dt while the disc falls).
+  function velocity(run, k, t) {
+    const s = run.states;
+    if (run.gravity && run.falls[k]) {
+      const dt = t - run.times[k];
+      return [s[4 * k + 2] + run.gravity[0] * dt, s[4 * k + 3] + run.gravity[1] * dt];
+    }
+    return [s[4 * k + 2], s[4 * k + 3]];
+  }
+
+  // Every disc's position at time t into run.x, run.y (its record into run.rec, its angle into run.angle).
   function evaluate(run, t) {
-    const s = run.states, w = run.box.width, h = run.box.height, periodic = run.box.periodic;
+    const w = run.box.width, h = run.box.height, periodic = run.box.periodic, turning = run.turning;
     for (let d = 0; d < run.n; d++) {
       const k = recordAt(run, d, t);
-      const dt = t - run.times[k];
-      let x = s[4 * k] + s[4 * k + 2] * dt;
-      let y = s[4 * k + 1] + s[4 * k + 3] * dt;
+      let [x, y] = centre(run, k, t);
       if (periodic) { x = wrap(x, w); y = wrap(y, h); }
       run.x[d] = x; run.y[d] = y; run.rec[d] = k;
+      if (turning) run.angle[d] = turning[2 * k + 1] + turning[2 * k] * (t - run.times[k]);
     }
   }
 
   function positionOf(run, d, t) {
-    const k = recordAt(run, d, t), s = run.states, dt = t - run.times[k];
-    let x = s[4 * k] + s[4 * k + 2] * dt, y = s[4 * k + 1] + s[4 * k + 3] * dt;
+    let [x, y] = centre(run, recordAt(run, d, t), t);
     if (run.box.periodic) { x = wrap(x, run.box.width); y = wrap(y, run.box.height); }
     return [x, y];
   }
@@ -127,8 +151,8 @@
     if (run.fixed[d]) return OBSTACLE;
     if (state.colour === "group") return TAB10[((run.groups[d] % 10) + 10) % 10];
     if (state.colour === "speed") {
-      const k = run.rec[d], s = run.states;
-      return viridis(run.maxSpeed > 0 ? Math.hypot(s[4 * k + 2], s[4 * k + 3]) / run.maxSpeed : 0);
+      const [vx, vy] = velocity(run, run.rec[d], run.drawnTime);
+      return viridis(run.maxSpeed > 0 ? Math.hypot(vx, vy) / run.maxSpeed : 0);
     }
     return TAB10[d % 10];
   }
@@ -204,6 +228,24 @@
       }
     }
     ctx.globalAlpha = 1;
+    if (run.turning) {  // each disc's angle: a radius from its centre
+      ctx.strokeStyle = "#111";
+      ctx.lineWidth = 1.2;
+      for (let d = 0; d < run.n; d++) {
+        const r = run.radii[d], a = run.angle[d];
+        if (!Number.isFinite(run.x[d]) || r * z < 3) continue;
+        for (const sx of shifts) {
+          for (const sy of shifts) {
+            const x = run.x[d] + sx * box.width, y = run.y[d] + sy * box.height;
+            if (x + r < 0 || x - r > box.width || y + r < 0 || y - r > box.height) continue;
+            ctx.beginPath();
+            ctx.moveTo(X(x), Y(y));
+            ctx.lineTo(X(x + r * Math.cos(a)), Y(y + r * Math.sin(a)));
+            ctx.stroke();
+          }
+        }
+      }
+    }
     if (state.contacts && contacts.length) {
       const window_ = DATA.contact_window;
       ctx.lineWidth = 1.8;
@@ -222,11 +264,11 @@
       ctx.strokeStyle = "#111";
       ctx.fillStyle = "#111";
       ctx.lineWidth = 1.2;
-      const s = run.states;
       for (let d = 0; d < run.n; d++) {
-        const k = run.rec[d], x = run.x[d], y = run.y[d];
+        const x = run.x[d], y = run.y[d];
         if (!Number.isFinite(x) || run.fixed[d]) continue;
-        const ex = X(x + s[4 * k + 2] * arrowTime), ey = Y(y + s[4 * k + 3] * arrowTime);
+        const [vx, vy] = velocity(run, run.rec[d], t);
+        const ex = X(x + vx * arrowTime), ey = Y(y + vy * arrowTime);
         const bx = X(x), by = Y(y), len = Math.hypot(ex - bx, ey - by);
         if (len < 1) continue;
         const head = Math.min(6, 0.4 * len), ux = (ex - bx) / len, uy = (ey - by) / len;
@@ -464,6 +506,12 @@
     return Array.from({ length: run.n }, (_, d) => [run.x[d], run.y[d]]);
   }
 
+  // The angles of the marks last drawn on a panel, [a, ...] (null: the run does not say how its discs turn).
+  function angles(panel = 0) {
+    const run = panels[panel].run;
+    return run.turning ? Array.from(run.angle) : null;
+  }
+
   // Writes {time, positions: [panel][disc][x, y]} into <pre id="ds-readout"> for tools that read the DOM.
   function readout() {
     const out = { time: state.t, drawn: panels.map((p) => p.run.drawnTime), positions: panels.map((_, k) => positions(k)) };
@@ -486,7 +534,7 @@
   window.addEventListener("resize", () => { layout(); render(); });
 
   window.discsim = {
-    seek, time: () => state.t, positions, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
+    seek, time: () => state.t, positions, angles, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
     setColour, setZoom, setArrows, zoom: () => state.zoom, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
     labels: runs.map((r) => r.label), eventTimes: () => eventTimes.slice(),
   };

@@ -17,7 +17,7 @@ import numpy as np
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, REMOVE
 from discsim.model import Box, Discs
-from discsim.trajectory import LastRecords, check_times, reconstruct, replay
+from discsim.trajectory import LastRecords, check_times, flight, reconstruct, replay, turning_at, turning_history
 
 __all__ = ["Frames", "frames", "log_source", "states_at"]
 
@@ -34,6 +34,9 @@ class Frames:
         velocities: ``(T, N, 2)`` velocities.
         box: the box.
         radii, masses: ``(N,)``; groups: ``(N,)`` integer group labels.
+        spins, angles: ``(T, N)`` each disc's angular velocity (radians per time unit) and angle (radians,
+            counter-clockwise, 0 at the run's start: what ``sim.angles`` says at those times), or None where the
+            source does not say (a streamed log: its spins are not in it).
     """
 
     times: np.ndarray
@@ -44,6 +47,8 @@ class Frames:
     radii: np.ndarray
     masses: np.ndarray
     groups: np.ndarray
+    spins: np.ndarray | None = None
+    angles: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.times)
@@ -54,8 +59,9 @@ class Frames:
         return len(self.radii)
 
     def discs(self, k: int = -1) -> Discs:
-        """Frame ``k`` as :class:`~discsim.model.Discs` (to start a new engine from it)."""
-        return Discs(self.positions[k], self.velocities[k], self.radii, self.masses, self.groups)
+        """Frame ``k`` as :class:`~discsim.model.Discs` (to start a new engine from it; with its spins if known)."""
+        spins = None if self.spins is None else self.spins[k]
+        return Discs(self.positions[k], self.velocities[k], self.radii, self.masses, self.groups, spins)
 
     @classmethod
     def from_discs(cls, discs: Discs, box: Box, time: float = 0.0, unwrapped=None) -> Frames:
@@ -81,6 +87,7 @@ class Frames:
             msg = "Frames.concatenate needs at least one Frames"
             raise InvalidArgumentError(msg)
         first = parts[0]
+        turning = all(p.spins is not None and p.angles is not None for p in parts)
         return cls(
             np.concatenate([p.times for p in parts]),
             np.concatenate([p.positions for p in parts]),
@@ -90,6 +97,8 @@ class Frames:
             first.radii,
             first.masses,
             first.groups,
+            np.concatenate([p.spins for p in parts]) if turning else None,  # type: ignore[misc]
+            np.concatenate([p.angles for p in parts]) if turning else None,  # type: ignore[misc]
         )
 
 
@@ -211,15 +220,47 @@ def _log_source(source, what: str):
     return (lambda: iter([sim.run_context.log.to_array()])), sim.discs, sim.box, sim.start_time, sim.time, sim
 
 
-def _refuse_gravity(engine, what: str) -> None:
-    """Refuse a run under gravity: the log's replay (:func:`discsim.trajectory.replay`) is free flight's."""
+def run_flight(source, engine, what: str):
+    """The gravity ``(gx, gy)`` (or None) of the run behind ``source``: its engine's laws, or a streamed log's
+    header (:func:`discsim.trajectory.flight`, which refuses drag)."""
+    from discsim.io.container import stream_index
+    from discsim.io.streams import StreamedEvents
+
+    if engine is not None:
+        laws = getattr(engine, "laws", None)
+        return flight(getattr(laws, "gravity", None), getattr(laws, "drag", 0.0), what=what)
+    if isinstance(source, StreamedEvents):
+        return flight(source.gravity, getattr(source, "drag", 0.0), what=what)
+    meta = stream_index(Path(source))[0]
+    return flight(meta.get("gravity"), meta.get("drag", 0.0), what=what)
+
+
+def _start_still(source, engine) -> np.ndarray | None:
+    """``(N,)`` bool, the discs at rest where a streamed log starts (its header's ``resting``), or None: none."""
+    from discsim.io.streams import StreamedEvents, iter_events
+
+    if engine is not None:
+        if not engine.run_context.streamed:
+            return None  # a log held in memory starts where the run starts: no disc at rest
+        source = engine.run_context.stream["path"]
+    if isinstance(source, StreamedEvents):
+        return source.resting
+    return iter_events(source, partial=engine is not None).resting
+
+
+def _turning(engine, discs: Discs, start: float, times: np.ndarray):
+    """``(spins, angles)`` ``(T, N)`` each at ``times`` for an engine's run (None, None where it does not say)."""
+    if engine is None or engine.run_context.streamed:
+        return None, None
     laws = getattr(engine, "laws", None)
-    if laws is not None and laws.falls:
-        msg = (
-            f"{what} replays free flight between events, and this run is under gravity {laws.gravity}: use "
-            "sim.trajectory(times) for exact positions, or sample the run with ds.Sampler(dt) while it runs"
-        )
-        raise InvalidArgumentError(msg)
+    spin_events = getattr(engine, "spin_events", None) if getattr(laws, "rough", False) else None
+    if getattr(laws, "rough", False) and spin_events is None:
+        return None, None
+    try:
+        history = turning_history(engine.run_context.log.to_array(), spin_events, discs.spins, start)
+    except ValueError:  # the spins after the log's events are not all held (e.g. a log from before spins)
+        return None, None
+    return turning_at(history, times)
 
 
 def frames(source, times) -> Frames:
@@ -232,11 +273,13 @@ def frames(source, times) -> Frames:
 
     Returns:
         :class:`Frames`: ``positions`` equal ``sim.trajectory(times)`` (to roundoff at the periodic edges),
-        ``unwrapped`` equal ``sim.trajectory(times, unwrapped=True)``, and the velocities at those times.
+        ``unwrapped`` equal ``sim.trajectory(times, unwrapped=True)``, and the velocities at those times: along
+        the exact parabolas under gravity (a disc at rest stays put). From an engine, also each disc's spin and
+        angle (``spins``, ``angles``: those of ``sim.spins`` and ``sim.angles`` at those times).
 
     Raises:
         InvalidArgumentError: if the run recorded nothing (``record=False``): sample during the run with
-            :class:`discsim.Sampler` instead.
+            :class:`discsim.Sampler` instead; or if it has drag (exponential flight, not replayed yet).
         TimeError: if a time is not finite or lies outside the run's span.
 
     Example:
@@ -247,11 +290,12 @@ def frames(source, times) -> Frames:
         ((3, 50, 2), True)
     """
     chunks, discs, box, start, end, engine = log_source(source, "frames()")
-    _refuse_gravity(engine, "frames()")
+    gravity = run_flight(source, engine, "frames()")
     times = check_times(times, start, end, "simulated span")
     # A streamed log is read one chunk at a time, up to the last time asked: memory flat in its length.
-    origin = LastRecords.at_start(discs, start)
-    unwrapped, velocities = replay(chunks(), origin, times, box, unwrapped=True, velocities=True)
+    origin = LastRecords.at_start(discs, start, still=_start_still(source, engine))
+    unwrapped, velocities = replay(chunks(), origin, times, box, unwrapped=True, velocities=True, gravity=gravity)
+    spins, angles = _turning(engine, discs, start, times)
     return Frames(
         times,
         box.wrap(unwrapped),
@@ -261,4 +305,6 @@ def frames(source, times) -> Frames:
         np.array(discs.radii, dtype=float),
         np.array(discs.masses, dtype=float),
         np.array(discs.groups),
+        spins,
+        angles,
     )

@@ -22,6 +22,10 @@ from discsim.scene import Scene, check_added
 
 __all__ = ["DiscEditing", "Uneditable"]
 
+#: What a :class:`~discsim.model.Discs` holds, in its constructor's order: every disc keeps all of it when discs
+#: are added or removed (its spin and moment of inertia too).
+_DISC_FIELDS = ("positions", "velocities", "radii", "masses", "groups", "spins", "inertia")
+
 
 class DiscEditing:
     """The disc-editing methods every engine shares (see the module docstring)."""
@@ -113,7 +117,7 @@ class DiscEditing:
 
     def add_discs(self, discs: Discs) -> np.ndarray:
         """Add ``discs`` (a :class:`~discsim.model.Discs` of ``K`` discs: positions in the box, velocities, radii,
-        masses, groups) at ``time``. Returns their indices ``N, ..., N + K - 1`` ``(K,)`` int64.
+        masses, groups, spins and inertia) at ``time``. Returns their indices ``N, ..., N + K - 1`` ``(K,)`` int64.
 
         Validated as the constructor validates the discs: each new disc must lie in the box (in ``[0, width)
         x [0, height)`` when periodic), clear of the walls, the segments, every disc already there and every
@@ -164,13 +168,7 @@ class DiscEditing:
             )
             raise UnitsError(msg)
         now = self.snapshot()
-        everyone = Discs(
-            np.concatenate([now.positions, discs.positions]),
-            np.concatenate([now.velocities, discs.velocities]),
-            np.concatenate([now.radii, discs.radii]),
-            np.concatenate([now.masses, discs.masses]),
-            np.concatenate([now.groups, discs.groups]),
-        )
+        everyone = Discs(*(np.concatenate([getattr(now, name), getattr(discs, name)]) for name in _DISC_FIELDS))
         scene = self.scene
         check_added(everyone, self.box, n, scene.segments, scene.pass_through)
         new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, check=False)
@@ -217,7 +215,7 @@ class DiscEditing:
         keep = np.delete(np.arange(n), idx)
         now = self.snapshot()
         gone_positions, gone_velocities = now.positions[np.sort(idx)], now.velocities[np.sort(idx)]
-        rest = Discs(now.positions[keep], now.velocities[keep], now.radii[keep], now.masses[keep], now.groups[keep])
+        rest = Discs(*(getattr(now, name)[keep] for name in _DISC_FIELDS))
         scene = self.scene
         new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
         gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()

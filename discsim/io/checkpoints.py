@@ -86,6 +86,9 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
     }
     out = {f"state.{name}": value for name, value in arrays.items()}
     out["events"] = context.log.to_array() if record else np.zeros(0, dtype=EVENT_DTYPE)
+    spin_events = getattr(engine, "spin_events", None)  # a rough run's spins after each event of its log
+    if record and spin_events is not None and len(spin_events):
+        out["spin_events"] = spin_events
     out.update(_discs_arrays("discs", discs))
     if context.origin is not None:  # the discs changed (add_discs, remove_discs): discs.* are today's scene
         origin, origin_ids = context.origin
@@ -237,6 +240,8 @@ def load(path, *, backend: str | None = None):
         else:
             scene = Scene(discs, box, segments, pass_through)
         sim = engine._restore(scene, settings, state, events, float(meta["start_time"]))
+        if "spin_events" in arrays:
+            sim._restore_spin_events(arrays["spin_events"])
         if changed:
             ids = np.asarray(arrays["ids"], dtype=np.int64)
             if ids.shape != (len(discs),):

@@ -16,7 +16,7 @@ from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import iter_stream, read_stream, stream_index
 from discsim.model import Box, Discs
-from discsim.trajectory import LastRecords, check_times, positions_from_log, replay
+from discsim.trajectory import LastRecords, check_times, flight, positions_from_log, replay
 
 __all__ = [
     "DEFAULT_CHUNK",
@@ -37,7 +37,15 @@ DEFAULT_CHUNK = 65_536
 
 
 def stream_header(
-    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None, gravity=None
+    discs: Discs,
+    box: Box,
+    start_time: float,
+    run_id: str,
+    base: int,
+    ids: np.ndarray | None = None,
+    gravity=None,
+    resting=None,
+    drag: float = 0.0,
 ) -> tuple[dict, dict]:
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
@@ -47,8 +55,12 @@ def stream_header(
         run_id: identifies the run, so that a resumed run appends only to its own log.
         base: physical events the run had processed before the log starts.
         ids: ``(N,)`` the discs' ids (``sim.ids``), stored only when given (None: their indices).
-        gravity: the run's ``(gx, gy)``, stored when given: a replay of the log (free flight between records)
-            then refuses to rebuild positions.
+        gravity: the run's ``(gx, gy)``, stored when given: a replay of the log then follows the parabolas
+            between records (and each disc's rest).
+        resting: ``(N,)`` bool, the discs at rest at ``start_time`` (under gravity), stored when any is: a log
+            started in the middle of a run replays them at rest until their next record.
+        drag: the run's drag ``gamma``, stored when not 0: replays (free flight and parabolas only) refuse the log
+            then, naming it.
     """
     meta = {
         "kind": STREAM_KIND,
@@ -60,6 +72,8 @@ def stream_header(
     }
     if gravity is not None:
         meta["gravity"] = [float(gravity[0]), float(gravity[1])]
+    if drag:
+        meta["drag"] = float(drag)
     arrays = {
         "positions": discs.positions,
         "velocities": discs.velocities,
@@ -69,6 +83,8 @@ def stream_header(
     }
     if ids is not None:
         arrays["ids"] = np.asarray(ids, dtype=np.int64)
+    if gravity is not None and resting is not None and np.any(resting):
+        arrays["resting"] = np.asarray(resting, dtype=bool)
     return meta, arrays
 
 
@@ -85,7 +101,8 @@ class StreamedEvents:
             time when it last wrote to the log).
         run_id: the run that wrote the log.
         ids: ``(N,)`` the ids of ``discs`` (the names the records give them), or None: their indices.
-        gravity: the run's ``(gx, gy)`` if it ran under gravity (then :meth:`trajectory` refuses), else None.
+        gravity: the run's ``(gx, gy)`` if it ran under gravity (:meth:`trajectory` follows its parabolas), else None.
+        resting: ``(N,)`` bool, the ``discs`` at rest at ``start_time`` (under gravity), or None: none.
     """
 
     events: np.ndarray
@@ -96,6 +113,7 @@ class StreamedEvents:
     run_id: str
     ids: np.ndarray | None = None
     gravity: tuple | None = None
+    resting: np.ndarray | None = None
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -106,9 +124,7 @@ class StreamedEvents:
 
         Raises:
             TimeError: if a time is not finite or lies outside the logged span.
-            InvalidArgumentError: if the run was under gravity (its replay would be free flight's).
         """
-        refuse_gravity("the streamed log", {"gravity": self.gravity})
         return positions_from_log(
             self.events,
             self.discs,
@@ -119,6 +135,8 @@ class StreamedEvents:
             span="logged span",
             unwrapped=unwrapped,
             ids=self.ids,
+            gravity=self.gravity,
+            still=self.resting,
         )
 
 
@@ -162,8 +180,27 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
     end_time = float(stream.last.get("time", start_time))
     gravity = stream.meta.get("gravity")
     return StreamedEvents(
-        stream.records, discs, box, start_time, end_time, run_id, ids, None if gravity is None else tuple(gravity)
+        stream.records,
+        discs,
+        box,
+        start_time,
+        end_time,
+        run_id,
+        ids,
+        None if gravity is None else tuple(gravity),
+        _resting(path, stream.arrays, len(discs)),
     )
+
+
+def _resting(path, arrays, n: int) -> np.ndarray | None:
+    """The header's ``resting`` ``(N,)`` bool (None: absent, no disc at rest where the log starts), checked."""
+    resting = arrays.get("resting")
+    if resting is None:
+        return None
+    if np.shape(resting) != (n,):
+        msg = f"{path}: the event log's header has resting of shape {np.shape(resting)} for {n} discs"
+        raise CheckpointError(msg)
+    return np.asarray(resting, dtype=bool)
 
 
 def _header(path, meta, arrays) -> tuple[Discs, Box, float, str, np.ndarray | None]:
@@ -213,6 +250,9 @@ class EventChunks:
         records: the number of records in the log (known from its index, before reading them).
         chunk: records per chunk at most. start: the time the chunks start from (None: the log's start).
         unwrapped: the ``before`` positions are unwrapped (periodic box).
+        gravity: the run's ``(gx, gy)`` from the header (None: free flight), which the unwrapped ``before``
+            positions follow between records. resting: ``(N,)`` bool, the ``discs`` at rest where the log starts
+            (None: none).
     """
 
     path: Path
@@ -227,9 +267,11 @@ class EventChunks:
     start: float | None
     unwrapped: bool
     partial: bool
+    gravity: tuple | None = None
+    resting: np.ndarray | None = None
 
     def __iter__(self) -> Iterator[EventChunk]:
-        carry = LastRecords.at_start(self.discs, self.start_time, self.ids)
+        carry = LastRecords.at_start(self.discs, self.start_time, self.ids, self.resting)
         walk = iter_stream(self.path, partial=self.partial)
         next(walk)  # the header
         start = -np.inf if self.start is None else self.start
@@ -239,16 +281,16 @@ class EventChunks:
                 msg = f"{self.path}: records of dtype {records.dtype}, expected the event dtype"
                 raise CheckpointError(msg)
             if len(records) and records["time"].max() < start:  # wholly before the start: only where it leaves discs
-                carry = carry.after(records, self.box, unwrapped=self.unwrapped)
+                carry = carry.after(records, self.box, unwrapped=self.unwrapped, gravity=self.gravity)
                 first += len(records)
                 continue
             skip = int(np.count_nonzero(records["time"] < start)) if self.start is not None else 0
             if skip:
-                carry = carry.after(records[:skip], self.box, unwrapped=self.unwrapped)
+                carry = carry.after(records[:skip], self.box, unwrapped=self.unwrapped, gravity=self.gravity)
             for at in range(skip, len(records), self.chunk):
                 piece = records[at : at + self.chunk]
                 yield EventChunk(piece, carry, first + at)
-                carry = carry.after(piece, self.box, unwrapped=self.unwrapped)
+                carry = carry.after(piece, self.box, unwrapped=self.unwrapped, gravity=self.gravity)
             first += len(records)
 
     def record_arrays(self) -> Iterator[np.ndarray]:
@@ -300,8 +342,6 @@ def iter_events(
         >>> bool(late.records["time"][0] >= 1.5), late.before.positions.shape
         (True, (20, 2))
     """
-    from discsim.errors import InvalidArgumentError
-
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         msg = f"chunk must be a positive integer (records per chunk), got {chunk!r}"
         raise InvalidArgumentError(msg)
@@ -314,25 +354,23 @@ def iter_events(
     end_time = float(chunks[-1].get("time", start_time)) if chunks else start_time
     total = sum(int(c.get("count", 0)) for c in chunks)
     start = None if start is None else float(start)
+    gravity = meta.get("gravity")
     return EventChunks(
-        path, discs, ids, box, start_time, end_time, run_id, total, int(chunk), start, unwrapped, partial
+        path,
+        discs,
+        ids,
+        box,
+        start_time,
+        end_time,
+        run_id,
+        total,
+        int(chunk),
+        start,
+        unwrapped,
+        partial,
+        None if gravity is None else (float(gravity[0]), float(gravity[1])),
+        _resting(path, arrays, len(discs)),
     )
-
-
-def refuse_gravity(path, meta) -> None:
-    """Refuse to replay a log streamed under gravity: the replay is free flight's between records.
-
-    Raises:
-        InvalidArgumentError: naming the file and the gravity.
-    """
-    gravity = meta.get("gravity") if isinstance(meta, dict) else None
-    if gravity is not None:
-        msg = (
-            f"{path}: this event log was streamed under gravity {tuple(gravity)}, and its replay is free flight's "
-            "between records: rebuild positions with sim.trajectory(times) while the run holds its log, or sample "
-            "the run with ds.Sampler(dt)"
-        )
-        raise InvalidArgumentError(msg)
 
 
 def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndarray:
@@ -359,8 +397,9 @@ def trajectory_from_events(source, times, *, unwrapped: bool = False) -> np.ndar
     """
     if isinstance(source, StreamedEvents):
         return source.trajectory(times, unwrapped=unwrapped)
-    refuse_gravity(source, stream_index(Path(source))[0])
+    meta = stream_index(Path(source))[0]
+    gravity = flight(meta.get("gravity"), meta.get("drag", 0.0), what=f"the replay of {str(source)!r}")
     log = iter_events(Path(source), unwrapped=unwrapped)
     times = check_times(times, log.start_time, log.end_time, "logged span")
-    origin = LastRecords.at_start(log.discs, log.start_time, log.ids)
-    return replay(log.record_arrays(), origin, times, log.box, unwrapped=unwrapped)
+    origin = LastRecords.at_start(log.discs, log.start_time, log.ids, log.resting)
+    return replay(log.record_arrays(), origin, times, log.box, unwrapped=unwrapped, gravity=gravity)

@@ -219,3 +219,17 @@ def test_the_interpreted_loop_gives_the_compiled_loops_events_bit_for_bit_under_
     _, compiled = _run(discs, box, 400, law_of_motion=wind)
     _, interpreted = _run(discs, box, 400, law_of_motion=wind, interpreted=True)
     assert compiled.tobytes() == interpreted.tobytes()
+
+
+@pytest.mark.parametrize("parts", [{"law_of_motion": wind}, {"collision_law": SimpleNamespace()}])
+def test_a_law_of_ones_own_under_other_laws_is_refused_naming_both(parts):
+    from discsim.engines.event_driven.engine import EventDriven
+    from discsim.engines.event_driven.numba.backend import NumbaBackend
+    from discsim.errors import InvalidArgumentError
+    from discsim.laws import Laws
+
+    discs, box = ds.random_gas(10, 0.2, seed=1)
+    scene, grid = Scene(discs, box), EventDriven.cell_grid(discs.radii, box)
+    name = next(iter(parts))
+    with pytest.raises(InvalidArgumentError, match=rf"{name}=SimpleNamespace.*default laws.*gravity=\(0.0, -9.81\)"):
+        NumbaBackend(scene, grid, "calendar", laws=Laws.build(gravity=(0.0, -9.81)), interpreted=True, **parts)

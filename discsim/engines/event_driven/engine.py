@@ -140,7 +140,8 @@ class EventDriven(Turning, RunStops, Engine):
         laws = Laws.build(gravity, restitution, tc, rest_speed, roughness, drag)
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
-        self._configure(Scene(discs, box, segments, pass_through), record, queue, cell_size, backend, laws)
+        scene = Scene(discs, box, segments, pass_through)
+        self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()
 
     def _configure(self, scene: Scene, record: bool, queue: str, cell_size, backend: str, laws: Laws) -> None:

@@ -51,9 +51,21 @@ class Turning:
         """A rough run's spins after each of its logged collisions and wall hits, in order: a
         :data:`~discsim.events.SPIN_DTYPE` array (``time``, ``i``, ``j``, ``wi``, ``wj``; ``wj`` NaN for a wall
         hit), the rows of :attr:`events`'s collisions and wall hits. Empty for smooth discs (``roughness=-1``:
-        spins never change) and when ``record=False``; held in memory only (not in checkpoints or streams)."""
+        spins never change) and when ``record=False``; kept in checkpoints (with the log), not in streamed logs."""
         chunks = getattr(self._backend, "spin_log", [])
         return np.concatenate(chunks) if chunks else np.zeros(0, dtype=SPIN_DTYPE)
+
+    def _restore_spin_events(self, rows: np.ndarray) -> None:
+        """Take back the :attr:`spin_events` a checkpoint holds (:data:`~discsim.events.SPIN_DTYPE` rows).
+
+        Raises:
+            ValueError: rows of another dtype.
+        """
+        if rows.dtype != SPIN_DTYPE:
+            msg = f"spin_events of dtype {rows.dtype}, expected {SPIN_DTYPE}"
+            raise ValueError(msg)
+        if len(rows) and hasattr(self._backend, "spin_log"):
+            self._backend.spin_log = [np.array(rows)]
 
     def kinetic_energy(self) -> float:
         """Total kinetic energy: translation ``sum(m |v|^2) / 2`` plus rotation ``sum(I w^2) / 2`` (over discs of

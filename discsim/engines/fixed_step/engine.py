@@ -211,7 +211,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness), policy)
         backend = _choose_backend(backend, policy)
         scene = Scene(discs, box, segments, pass_through)
-        self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws)
+        self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws.checked(scene))
         self._load(self._initial_state())
 
     def _configure(

@@ -188,3 +188,12 @@ def test_drag_zero_is_todays_physics():
 def test_bad_drag_is_refused_naming_it(drag):
     with pytest.raises(InvalidArgumentError, match="drag"):
         ds.EventDriven(ball(5.0, 5.0), BOX, drag=drag)
+
+
+def test_a_log_streamed_under_drag_says_so_and_its_replays_refuse_it(tmp_path):
+    path = tmp_path / "drag.dslog"
+    ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=0.5).run(until=3.0, record_to=path)
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.frames(path, [1.0])
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.trajectory_from_events(path, [1.0])

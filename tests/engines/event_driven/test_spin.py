@@ -217,6 +217,18 @@ def test_the_spin_log_follows_the_event_log():
     assert sim.trajectory([sim.time])[0] == pytest.approx(sim.positions, rel=1e-12)  # spin moves no centre
 
 
+def test_a_rough_run_s_frames_carry_each_disc_s_spin_and_angle():
+    discs, box = gas(seed=8, periodic=False)
+    sim = ds.EventDriven(discs, box, roughness=0.6).run(events=200)
+    half = ds.EventDriven(discs, box, roughness=0.6).run(until=sim.time / 2)
+    f = ds.frames(sim, [0.0, sim.time / 2, sim.time])
+    assert (f.angles[0] == 0.0).all()  # angles count from the start (its wall hits at t = 0 done: their spins)
+    assert f.spins[1].tolist() == half.spins.tolist() and f.spins[2].tolist() == sim.spins.tolist()
+    assert f.angles[1] == pytest.approx(half.angles, rel=1e-12, abs=1e-12)
+    assert f.angles[2] == pytest.approx(sim.angles, rel=1e-12, abs=1e-12)
+    assert f.discs(1).spins.tolist() == half.spins.tolist()
+
+
 @pytest.mark.slow
 def test_a_rough_elastic_gas_shares_its_energy_equally_among_its_degrees_of_freedom():
     # beta = 1, I = m r^2 / 2: one rotational and two translational degrees of freedom per disc, so the
@@ -232,6 +244,35 @@ def test_a_rough_elastic_gas_shares_its_energy_equally_among_its_degrees_of_free
 
 
 # --- state, checkpoints, bad input ----------------------------------------------------------------------------
+def _free_spot(sim, radius, seed=0):
+    rng, box = np.random.default_rng(seed), sim.box
+    while True:
+        p = rng.uniform(radius, [box.width - radius, box.height - radius])
+        d = box.minimum_image(sim.positions - p)
+        if (np.hypot(d[:, 0], d[:, 1]) > (sim.discs.radii + radius) * 1.01).all():
+            return p
+
+
+@pytest.mark.parametrize("roughness", [0.5, -1.0])
+def test_added_discs_keep_their_spins_and_every_disc_its_inertia(roughness, tmp_path):
+    discs, box = gas(seed=3, periodic=False)
+    n = len(discs)
+    inertia = np.linspace(0.2, 0.6, n)
+    discs = ds.Discs(discs.positions, discs.velocities, discs.radii, spins=discs.spins, inertia=inertia)
+    sim = ds.EventDriven(discs, box, roughness=roughness).run(events=50)
+    spins, angles = sim.spins.copy(), sim.angles.copy()
+    new = ds.Discs([_free_spot(sim, 0.3)], [[0.0, 0.0]], radii=0.3, spins=[2.5], inertia=[0.01])
+    (k,) = sim.add_discs(new)
+    assert sim.spins.tolist() == [*spins.tolist(), 2.5] and sim.angles.tolist() == [*angles.tolist(), 0.0]
+    assert sim.discs.inertia.tolist() == [*inertia.tolist(), 0.01] and sim.snapshot().spins[k] == 2.5
+    loaded = ds.load(sim.save(tmp_path / "added.dsc"))  # and through a checkpoint
+    assert loaded.spins.tolist() == sim.spins.tolist() and loaded.angles.tolist() == sim.angles.tolist()
+    assert loaded.discs.inertia.tolist() == sim.discs.inertia.tolist()
+    sim.remove_discs([0])
+    assert sim.discs.inertia.tolist() == [*inertia[1:].tolist(), 0.01] and sim.spins[-1] == 2.5
+    assert sim.spins[:-1].tolist() == spins[1:].tolist()
+
+
 def test_a_rough_run_continues_from_a_checkpoint_bit_for_bit(tmp_path):
     discs, box = gas(seed=9)
     inertia = np.linspace(0.2, 0.6, len(discs))
@@ -246,6 +287,21 @@ def test_a_rough_run_continues_from_a_checkpoint_bit_for_bit(tmp_path):
     assert np.array_equal(resumed.events[-300:], whole.events[-300:])
     assert resumed.spins.tolist() == whole.spins.tolist()
     assert resumed.angles == pytest.approx(whole.angles, rel=1e-12, abs=1e-12)
+
+
+def test_a_checkpoint_carries_the_spin_log_so_frames_and_the_viewer_still_turn(tmp_path):
+    discs, box = gas(seed=9)
+    sim = ds.EventDriven(discs, box, roughness=0.5).run(events=100)
+    loaded = ds.load(sim.save(tmp_path / "rough.dsc"))
+    assert np.array_equal(loaded.spin_events, sim.spin_events) and len(loaded.spin_events) == 100
+    times = [sim.time / 2, sim.time]
+    assert np.array_equal(ds.frames(loaded, times).angles, ds.frames(sim, times).angles)
+    assert '"turning":null' not in ds.view(loaded, path=None).html
+    whole = ds.EventDriven(discs, box, roughness=0.5).run(events=150)
+    assert np.array_equal(loaded.run(events=50).spin_events, whole.spin_events)
+    # A run that records nothing keeps no spin log, nor does its checkpoint.
+    quiet = ds.EventDriven(discs, box, roughness=0.5, record=False).run(events=20)
+    assert len(ds.load(quiet.save(tmp_path / "quiet.dsc")).spin_events) == 0
 
 
 def test_a_state_from_before_spins_reads_with_spins_zero():

@@ -18,6 +18,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.numba.reads import CompiledReads
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
+from discsim.errors import InvalidArgumentError
 from discsim.events import EVENT_DTYPE, SPIN_DTYPE, EventKind, EventLog
 from discsim.laws import Laws
 from discsim.physics import dynamics
@@ -68,6 +69,10 @@ class NumbaBackend(CompiledReads):
             events bit for bit.
         laws: gravity, restitution, the TC time and the rest speed (:class:`~discsim.laws.Laws`; None: the
             defaults), numbers the loop reads at run time (one compiled loop serves every value).
+
+    Raises:
+        InvalidArgumentError: a ``law_of_motion`` or ``collision_law`` given with laws other than the defaults
+            (the loop that reads the laws is compiled over the built-in parts only), naming both.
     """
 
     name = "numba"
@@ -83,6 +88,17 @@ class NumbaBackend(CompiledReads):
         interpreted=False,
         laws: Laws | None = None,
     ):
+        if laws is not None and not laws.default and (law_of_motion is not None or collision_law is not None):
+            given = ", ".join(
+                f"{name}={getattr(part, '__name__', type(part).__name__)}"
+                for name, part in (("law_of_motion", law_of_motion), ("collision_law", collision_law))
+                if part is not None
+            )
+            msg = (
+                f"{given} runs with the default laws only (free flight, elastic, smooth), and these laws are "
+                f"not: {_spelled(laws)}; compile that law with the defaults, or use the built-in laws alone"
+            )
+            raise InvalidArgumentError(msg)
         self.scene = scene
         self.laws = laws or Laws()
         self.box = scene.box
@@ -92,9 +108,6 @@ class NumbaBackend(CompiledReads):
         self._lp = _loop()
         self._law_of_motion = law_of_motion or dynamics
         if not self.laws.default:  # the loop that reads the laws (one for every value of them)
-            if law_of_motion is not None or collision_law is not None:
-                msg = "a law of motion or collision law of one's own runs with the default laws only"
-                raise NotImplementedError(msg)
             self._lp = SimpleNamespace(**_variants().with_laws(interpreted=interpreted))
         elif law_of_motion is not None or collision_law is not None or interpreted:
             variants = _variants()
@@ -427,6 +440,16 @@ def _records(events, k: int) -> np.ndarray:
     for c, name in enumerate(("xi", "yi", "vxi", "vyi", "xj", "yj", "vxj", "vyj")):
         out[name] = ev_f[:k, c]
     return out
+
+
+def _spelled(laws: Laws) -> str:
+    """The laws that differ from the defaults, as keywords: ``gravity=(0.0, -9.81), restitution=0.8``."""
+    default = Laws()
+    return ", ".join(
+        f"{name}={getattr(laws, name)!r}"
+        for name in ("gravity", "restitution", "tc", "rest_speed", "roughness")
+        if getattr(laws, name) != getattr(default, name)
+    )
 
 
 def _spin_records(events, k: int) -> np.ndarray:

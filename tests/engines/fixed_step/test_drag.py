@@ -1,5 +1,5 @@
 """Linear drag in the fixed-step engine (PIT): the exact exponential flight at and between the frames, the drag's
-loss in ``dissipated``, the trajectory, checkpoints, bad input (issue 27, items 4, 5).
+loss in ``dissipated``, the trajectory, PIT against PIC under drag, checkpoints, bad input (issue 27, items 4, 5).
 
 Every test runs once per backend (``every_backend``, autouse in this folder's conftest); the two backends give the
 same frames bit for bit under drag too (``test_backends.py``).
@@ -148,6 +148,34 @@ def test_energy_plus_dissipated_is_constant_under_drag_with_resolve(gravity):
     e1 = sim.energy() + sim.dissipated
     sim.run(frames=20)
     assert sim.energy() + sim.dissipated == pytest.approx(e1, rel=1e-12)
+
+
+# --- PIT against PIC under drag -------------------------------------------------------------------------------
+@pytest.mark.parametrize("policy", FRAME_POLICIES)
+def test_the_terminal_fall_case_compares_pit_with_pic_under_drag(policy):
+    case = ds.scenarios.terminal_fall()
+    assert [c.name for c in ds.scenarios.law_cases()] == ["bouncing_ball", "terminal_fall"]
+    g, gamma = -case.laws["gravity"][1], case.laws["drag"]
+    h0 = float(case.discs.positions[0, 1] - case.discs.radii[0])
+    pic = ds.EventDriven(case.discs, case.box, **case.laws).run(until=case.until)
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate, policy=policy, **case.laws)
+    pit.run(until=case.until)
+    # PIC: the floor at the time the drop at (almost) terminal velocity reaches h0.
+    hit = float(pic.events["time"][0])
+    assert g / gamma * (hit - tau(hit, gamma)) == pytest.approx(h0, rel=1e-13)
+    assert pic.events["vyi"][0] == pytest.approx(case.laws["restitution"] * g / gamma * -math.expm1(-gamma * hit))
+    report = ds.compare(pic, pit)
+    assert report.truth_wall_hits == len(pic.events) >= 3
+    # PIT: on the same exact flight until then, it answers the first bounce at the first frame past the floor.
+    assert 0.0 < report.wall_delays[0] < case.dt
+    assert report.wall_matches[0][1] == pytest.approx(hit, rel=1e-15)
+    assert abs(report.truth_energy_error) < 1e-12
+    if policy == "resolve":  # drag and restitution take all that it loses
+        assert abs(report.approx_energy_error) < 1e-12
+    else:  # "revert" and "separate" lift the ball at each bounce
+        assert report.approx_energy_error > 1e-3
+    assert pit.dissipated > 0.9 * pic.dissipated
+    assert "energy error" in str(report)
 
 
 # --- checkpoints, the default, bad input --------------------------------------------------------------------------

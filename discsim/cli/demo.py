@@ -2,7 +2,8 @@
 
 Prints one comparison row per case and writes a figure per case, all four in one figure and an animation of
 the multiple-collisions case to a folder; then one row per case under the laws of motion
-(:func:`discsim.scenarios.law_cases`: a ball bouncing to rest under gravity with restitution), table only.
+(:func:`discsim.scenarios.law_cases`: a ball bouncing to rest under gravity with restitution, a ball falling at
+its terminal velocity under drag), table only.
 """
 
 from __future__ import annotations
@@ -159,7 +160,7 @@ def handle(args: argparse.Namespace) -> int:
             pic = ds.EventDriven(case.discs, case.box, **case.laws).run(until=case.until)
             pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate, policy=args.policy, **case.laws)
             law_rows.append((case.name, case.frame_rate, ds.compare(pic, pit.run(until=case.until))))
-        print(f"\nUnder gravity and restitution, PIT ({args.policy}) against PIC: bounces (wall hits) and energy:\n")
+        print(f"\nUnder the laws of motion, PIT ({args.policy}) against PIC: bounces (wall hits) and energy:\n")
         print(law_table(law_rows))
     print(f"\nFigures written to {out.resolve()}:")
     for path in written:

@@ -13,6 +13,7 @@ from discsim.engines.fixed_step.parts import impulse_virial, wrap
 from discsim.events import EventLog
 from discsim.laws import PER_GROUP, E, Laws
 from discsim.model import image_step, image_steps
+from discsim.physics.damped import spans
 from discsim.physics.dynamics import advance
 from discsim.scene import Scene
 
@@ -25,7 +26,8 @@ class Shapes:
     Attributes:
         box: the :class:`~discsim.model.Box`. scene: the :class:`~discsim.scene.Scene`.
         radii ``(N,)`` float array and radius (list of N floats): the radii (length).
-        masses (list of N floats, inf for an obstacle). moving (list of N bools): finite mass.
+        mass ``(N,)`` float array and masses (list of N floats): the masses (inf for an obstacle).
+        moving (list of N bools): finite mass.
         diameter: the largest diameter (a third of the box's shorter side with no discs): the broad phase's
             cell side.
         max_radius: half of ``diameter``.
@@ -33,8 +35,9 @@ class Shapes:
             ``(x0, y0, x1, y1)``): the same as floats.
         group (list of N ints) and blocked (G lists of G bools): the collision filter
             (:meth:`~discsim.scene.Scene.passes`) as lists, or None when no groups pass through each other.
-        laws: the run's :class:`~discsim.laws.Laws`. gravity: ``(gx, gy)``. falls ``(N,)`` bool: the discs
-            gravity moves (finite mass; all False without gravity).
+        laws: the run's :class:`~discsim.laws.Laws`. gravity: ``(gx, gy)``. drag: the drag ``gamma`` (0: none).
+            falls ``(N,)`` bool: the discs on a curved path, that gravity or drag moves (finite mass; all False
+            without either).
         e (float), per_group (bool), e_table (G lists of G floats), e_group (list of N ints), tc (float): the
             arguments of :func:`~discsim.engines.fixed_step.parts.restitution` (``e_group`` indexes
             ``e_table`` by the rank of each disc's group label).
@@ -51,6 +54,7 @@ class Shapes:
         self.max_radius = 0.5 * self.diameter
         self.radii = np.array(discs.radii)
         self.radius = discs.radii.tolist()
+        self.mass = np.array(discs.masses)
         self.masses = discs.masses.tolist()
         self.moving = np.isfinite(discs.masses).tolist()
         self.seg_a = np.array([segment.p0 for segment in scene.segments]).reshape(-1, 2)
@@ -61,7 +65,8 @@ class Shapes:
         laws = Laws.build() if laws is None else laws
         self.laws = laws
         self.gravity = laws.gravity
-        self.falls = np.isfinite(discs.masses) & laws.falls
+        self.drag = laws.drag
+        self.falls = np.isfinite(discs.masses) & (laws.falls or laws.drag != 0.0)
         law = laws.array(discs.radii)
         self.e, self.per_group, self.tc = float(law[E]), bool(law[PER_GROUP]), laws.tc
         labels = np.unique(discs.groups)
@@ -79,7 +84,8 @@ class Paths:
     event log, so frame positions and ``trajectory()`` agree to the last bit); that point is not wrapped,
     and adding ``images[i] * box.size`` to it unwraps it. Under gravity a disc that falls follows the
     parabola of :func:`~discsim.physics.dynamics.advance` from there instead, ``velocities[i]`` being its
-    velocity at ``ref_times[i]``; every frame starts its path afresh (:meth:`fall`).
+    velocity at ``ref_times[i]``, and under drag its exact exponential flight (with gravity or without); every
+    frame starts its path afresh (:meth:`fall`).
 
     Attributes:
         box: the :class:`~discsim.model.Box`.
@@ -89,7 +95,8 @@ class Paths:
         images ``(N, 2)`` int64: box lengths to add to ``ref_positions`` to unwrap them.
         frame_positions ``(N, 2)``: the positions at the last frame, wrapped into a periodic box.
         last_collision ``(N,)``: each disc's last response time (``-inf``: none; kept for the TC model only).
-        gravity: ``(gx, gy)``; falls ``(N,)`` bool: the discs it moves (None: no gravity).
+        gravity: ``(gx, gy)``; drag: the drag ``gamma`` (1 / time; 0: none); falls ``(N,)`` bool: the discs on
+            a curved path, that gravity or drag moves (None: neither).
         spins ``(N,)``: the angular velocities (radians per time, counter-clockwise); changed only by the
             responses of rough discs. angles ``(N,)``: each disc's angle at its time in ``angle_times``
             ``(N,)`` (:meth:`turning` gives them all at one time).
@@ -97,7 +104,7 @@ class Paths:
 
     def __init__(
         self, box, ref_positions, ref_times, velocities, images, frame_positions, last_collision=None,
-        gravity=(0.0, 0.0), falls=None, spins=None, angles=None, angle_time=0.0,
+        gravity=(0.0, 0.0), falls=None, spins=None, angles=None, angle_time=0.0, drag=0.0,
     ):  # fmt: skip
         self.box = box
         self.ref_positions = ref_positions
@@ -107,7 +114,9 @@ class Paths:
         self.frame_positions = frame_positions
         self.last_collision = np.full(len(ref_times), -np.inf) if last_collision is None else last_collision
         self.gravity = (float(gravity[0]), float(gravity[1]))
-        self.falls = falls if falls is not None and gravity != (0.0, 0.0) and falls.any() else None
+        self.drag = float(drag)
+        curved = self.gravity != (0.0, 0.0) or self.drag != 0.0
+        self.falls = falls if falls is not None and curved and falls.any() else None
         n = len(ref_times)
         self.spins = np.zeros(n) if spins is None else spins
         self.angles = np.zeros(n) if angles is None else angles
@@ -126,9 +135,8 @@ class Paths:
         """``(N, 2)`` positions at time ``t`` on the current paths, not wrapped."""
         out = self.ref_positions + self.velocities * (t - self.ref_times)[:, None]
         falls = self.falls
-        if falls is not None:  # the parabola, as the compiled frame computes it disc by disc
-            (x, y), (vx, vy) = self.ref_positions[falls].T, self.velocities[falls].T
-            out[falls, 0], out[falls, 1], _, _ = advance(x, y, vx, vy, t - self.ref_times[falls], *self.gravity)
+        if falls is not None:  # the parabola or the damped flight, as the compiled frame computes it disc by disc
+            out[falls, 0], out[falls, 1], _, _ = self._curved(t)
         return out
 
     def velocities_at(self, t: float) -> np.ndarray:
@@ -136,13 +144,44 @@ class Paths:
         out = self.velocities.copy()
         falls = self.falls
         if falls is not None:
-            (x, y), (vx, vy) = self.ref_positions[falls].T, self.velocities[falls].T
-            _, _, out[falls, 0], out[falls, 1] = advance(x, y, vx, vy, t - self.ref_times[falls], *self.gravity)
+            _, _, out[falls, 0], out[falls, 1] = self._curved(t)
         return out
 
+    def _curved(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(x, y, vx, vy)`` at time ``t`` of the discs on curved paths (``falls``), each an array.
+
+        Under drag the spans come from :func:`~discsim.physics.damped.spans` (:mod:`math`, as the compiled
+        frame computes them), once per distinct flight time (one, at a frame), then the operations of
+        :func:`~discsim.physics.dynamics.advance`: the same bits as the compiled frame's.
+        """
+        falls = self.falls
+        (x, y), (vx, vy) = self.ref_positions[falls].T, self.velocities[falls].T
+        dt = t - self.ref_times[falls]
+        gx, gy = self.gravity
+        if self.drag == 0.0:
+            return advance(x, y, vx, vy, dt, gx, gy)
+        flights, which = np.unique(dt, return_inverse=True)
+        tau, s, e = np.array([spans(float(d), self.drag) for d in flights.tolist()]).reshape(-1, 3)[which].T
+        return x + vx * tau + gx * s, y + vy * tau + gy * s, vx * e + gx * tau, vy * e + gy * tau
+
+    def drag_loss(self, t: float, mass: np.ndarray, rows=None) -> np.ndarray:
+        """What the drag took from each disc on a curved path (``falls``, in order; or of those, ``rows``) over its
+        flight from its reference time to ``t`` (energy): its kinetic energy lost plus the work gravity did on it,
+        ``m (|v0|^2 - |v|^2) / 2 + m g . (r - r0)``, with the compiled frame's operations. ``mass`` ``(N,)``: the
+        masses (:attr:`Shapes.mass`)."""
+        falls = self.falls
+        x, y, vx, vy = self._curved(t)
+        (x0, y0), (vx0, vy0) = self.ref_positions[falls].T, self.velocities[falls].T
+        gx, gy = self.gravity
+        loss = mass[falls] * (0.5 * ((vx0 * vx0 + vy0 * vy0) - (vx * vx + vy * vy)) + gx * (x - x0) + gy * (y - y0))
+        if rows is not None:
+            loss = loss[np.searchsorted(np.flatnonzero(falls), rows)]
+        return loss
+
     def fall(self, t: float, flown: np.ndarray) -> None:
-        """Under gravity, every disc that falls starts a new path at time ``t`` from ``flown`` (:meth:`flown` at
-        ``t``, not wrapped), with its velocity there: a frame's responses see the velocities at the frame."""
+        """Under gravity or drag, every disc on a curved path starts a new path at time ``t`` from ``flown``
+        (:meth:`flown` at ``t``, not wrapped), with its velocity there: a frame's responses see the velocities at
+        the frame."""
         falls = self.falls
         if falls is None:
             return
@@ -198,7 +237,8 @@ class Tally:
         virial (float): the sum over the disc-disc impulses applied of ``dp_i . (r_i - r_j)`` (energy):
             ``dp_i`` the momentum disc ``i`` receives, ``r_i - r_j`` the minimum-image separation of the
             pair where the impulse is applied (see :func:`impulse_virial`).
-        dissipated (float): the kinetic energy the responses with restitution below 1 took (energy).
+        dissipated (float): the kinetic energy the responses with restitution below 1 or roughness took, and
+            what the drag took over the flights up to the last frame (energy; :meth:`lose`).
         log (EventLog or None): where responses are logged (None: not recorded).
     """
 
@@ -213,3 +253,10 @@ class Tally:
         self.virial = float(virial)
         self.dissipated = float(dissipated)
         self.log: EventLog | None = None
+
+    def lose(self, losses: np.ndarray) -> None:
+        """Add ``losses`` (energy) to :attr:`dissipated` one by one in order, as the compiled frame adds them."""
+        dissipated = self.dissipated
+        for loss in losses.tolist():
+            dissipated += loss
+        self.dissipated = dissipated

@@ -12,8 +12,9 @@ answers with one of five policies, chosen once when the engine is built:
 Between responses discs fly straight, so the event log (one record per response, with the state just
 after it) rebuilds the exact path the engine took, and ``trajectory()`` works as for the event-driven
 engine. The laws of :class:`~discsim.engines.event_driven.EventDriven` apply too (``gravity=``,
-``restitution=``, ``tc=``, ``roughness=``): under gravity every disc of finite mass follows the exact parabola over a
-frame (:func:`~discsim.physics.dynamics.advance`; ``trajectory()`` adds the fall since each disc's last record),
+``restitution=``, ``tc=``, ``roughness=``, ``drag=``): under gravity every disc of finite mass follows the exact
+parabola over a frame, under drag the exact exponential flight (:func:`~discsim.physics.dynamics.advance`;
+``trajectory()`` adds the fall since each disc's last record),
 and the responses apply the restitution, and the roughness that turns the discs (``spins``, ``angles``), through the
 same collision law (:mod:`discsim.physics.laws`).
 The broad phase (:mod:`~discsim.engines.fixed_step.broad_phase`) is a Verlet list on a cell grid or every
@@ -116,11 +117,15 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             :attr:`spins`, :attr:`angles`), every policy alike; the energy taken in :attr:`dissipated`.
         rest_speed: checked as ``EventDriven`` checks it, and ignored: PIT has no rest (a disc on a floor
             keeps bouncing from frame to frame).
+        drag: the linear drag ``gamma`` >= 0 (1 / time; 0, the default: none, today's frames bit for bit), as for
+            ``EventDriven``: over a frame and between frames each disc of finite mass follows the exact exponential
+            flight (velocity ``v e^(-gamma t) + g tau(t)``, ``tau = (1 - e^(-gamma t)) / gamma``; the frame
+            policies only: ``"bisect"`` and ``"swept"`` refuse it); what it takes counts in :attr:`dissipated`.
 
     Raises:
         InvalidArgumentError: on a frame rate, ``dt`` or ``bisect_tol`` that is
-            not a positive finite number, a law refused as ``EventDriven`` refuses it, gravity with a
-            sub-frame policy, both of ``frame_rate`` and ``dt`` given
+            not a positive finite number, a law refused as ``EventDriven`` refuses it (a negative or non-finite
+            ``drag`` too), gravity or drag with a sub-frame policy, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
             a periodic box, ``backend="numba"`` without numba (naming the extra to
             install).
@@ -189,6 +194,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         tc: float = 0.0,
         rest_speed: float | None = None,
         roughness: float = -1.0,
+        drag: float = 0.0,
     ):
         if dt is None:
             rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
@@ -208,7 +214,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             msg = f"broad_phase must be one of {list(BROAD_PHASES)}, got {broad_phase!r}"
             raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
-        laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness), policy)
+        laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
         backend = _choose_backend(backend, policy)
         scene = Scene(discs, box, segments, pass_through)
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws.checked(scene))
@@ -351,6 +357,9 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
     def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
         paths, t = self._paths, self.time
         flown = paths.flown(t)
+        if paths.drag != 0.0 and paths.falls is not None:  # what the drag took over the flights the edit ends
+            rows = indices[paths.falls[indices]]
+            self._tally.lose(paths.drag_loss(t, self._shapes.mass, rows))
         for k, i in enumerate(indices.tolist()):
             x, y = (flown[i] if positions is None else positions[k]).tolist()
             vx, vy = velocities[k].tolist()
@@ -483,18 +492,20 @@ def _restored_laws(settings: dict) -> Laws:
 
 
 def _check_laws(laws: Laws, policy: str) -> Laws:
-    """``laws``, unless ``policy`` cannot follow them: gravity inside a frame (the sub-frame policies' paths are
-    straight).
+    """``laws``, unless ``policy`` cannot follow them: gravity or drag inside a frame (the sub-frame policies'
+    paths are straight).
 
     Raises:
-        InvalidArgumentError: naming the gravity and the policy.
+        InvalidArgumentError: naming the gravity (or the drag) and the policy.
     """
-    if laws.falls and policy in SUB_FRAME_POLICIES:
-        msg = (
-            f"gravity={laws.gravity} needs a policy that answers at the frame ('resolve', 'revert' or 'separate'): "
-            f"policy {policy!r} finds contacts inside a frame along straight paths"
-        )
-        raise InvalidArgumentError(msg)
+    if policy in SUB_FRAME_POLICIES:
+        law = f"gravity={laws.gravity}" if laws.falls else f"drag={laws.drag!r}" if laws.drag != 0.0 else None
+        if law is not None:
+            msg = (
+                f"{law} needs a policy that answers at the frame ('resolve', 'revert' or 'separate'): "
+                f"policy {policy!r} finds contacts inside a frame along straight paths"
+            )
+            raise InvalidArgumentError(msg)
     return laws
 
 

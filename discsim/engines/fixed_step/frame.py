@@ -119,7 +119,9 @@ class FramePolicy(Policy):
         box = self.shapes.box
         prev = paths.frame_positions
         flown = paths.flown(t)
-        paths.fall(t, flown)  # under gravity: the velocities at the frame
+        if paths.drag != 0.0 and paths.falls is not None:  # what the drag took since the last frame
+            tally.lose(paths.drag_loss(t, self.shapes.mass))
+        paths.fall(t, flown)  # under gravity or drag: the velocities at the frame
         pos = box.wrap(flown)
         events: list[Event] = []
         if not box.periodic:

@@ -16,6 +16,7 @@ from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.errors import InvalidArgumentError
 from discsim.laws import Laws
 from discsim.model import Box, Discs, _readonly, kinetic_energy, rotational_energy
+from discsim.physics.damped import spans_many
 
 __all__ = ["FrameReadout"]
 
@@ -84,7 +85,8 @@ class FrameReadout:
 
     @property
     def velocities(self) -> np.ndarray:
-        """``(N, 2)`` velocities at ``time`` (a fresh copy; under gravity, between frames, on the parabola)."""
+        """``(N, 2)`` velocities at ``time`` (a fresh copy; under gravity or drag, between frames, on the exact
+        path)."""
         if self._paths.falls is not None and self.time != self._frame_time:
             return _readonly(self._paths.velocities_at(self.time))
         return _readonly(self._paths.velocities.copy())
@@ -115,13 +117,19 @@ class FrameReadout:
     @property
     def dissipated(self) -> float:
         """Kinetic energy taken since the start by the responses with restitution below 1 or roughness strictly
-        between -1 and 1, the rotational energy included (0 for elastic, smooth discs).
+        between -1 and 1, the rotational energy included, and by the drag (0 for elastic, smooth discs without
+        drag).
 
-        Only the collision law's loss: what the frames' own errors add or take (a disc that sinks into the
-        floor before its bounce, ``"separate"`` lifting it out, ``"revert"`` sending it back) is not counted,
-        so ``energy() + dissipated`` drifts from its start by the stepping's error alone.
+        The drag's part is what it took over each exact flight, up to ``time`` (the flights under way included):
+        the kinetic energy lost plus the work gravity did. Only the laws' losses: what the frames' own errors
+        add or take (a disc that sinks into the floor before its bounce, ``"separate"`` lifting it out,
+        ``"revert"`` sending it back) is not counted, so ``energy() + dissipated`` drifts from its start by the
+        stepping's error alone.
         """
-        return self._tally.dissipated
+        paths = self._paths
+        if paths.drag == 0.0 or paths.falls is None or self.time == self._frame_time:
+            return self._tally.dissipated
+        return self._tally.dissipated + float(np.sum(paths.drag_loss(self.time, self._shapes.mass)))
 
     def pressure(self) -> float:
         """Pressure from the virial of the impulses the frames applied, averaged since the start.
@@ -180,8 +188,9 @@ class FrameReadout:
         :meth:`~discsim.engines.record.EventRecord.trajectory`).
 
         Under gravity each disc of finite mass follows its parabola from its last record (the log's straight
-        path plus ``g dt^2 / 2``, ``dt`` the time since that record): the engine's own positions at the
-        frames, to rounding.
+        path plus ``g dt^2 / 2``, ``dt`` the time since that record); under drag its exact exponential flight
+        (the log's, :func:`~discsim.physics.dynamics.advance_many`, plus ``g s(dt)`` under gravity): the engine's
+        own positions at the frames, to rounding.
 
         Raises:
             InvalidArgumentError: as the log's trajectory; and under gravity, after ``add_discs`` or
@@ -189,19 +198,20 @@ class FrameReadout:
         """
         out = super().trajectory(times, unwrapped=unwrapped)  # type: ignore[misc]  # the log's (EventRecord)
         falls = self._shapes.falls
-        if not falls.any():
+        if not (self.laws.falls and falls.any()):  # under drag alone the log's flights are the engine's
             return out
         if self.run_context.origin is not None:
             msg = "trajectory() under gravity is not rebuilt after add_discs or remove_discs"
             raise InvalidArgumentError(msg)
         asked = np.atleast_1d(np.asarray(times, dtype=float))
         events = self.events
-        g = np.array(self.laws.gravity)
+        g, drag = np.array(self.laws.gravity), self.laws.drag
         for d in np.flatnonzero(falls).tolist():
             records = events["time"][(events["i"] == d) | (events["j"] == d)]  # in time order
             last = np.concatenate([[self.start_time], records])[np.searchsorted(records, asked, side="right")]
             since = asked - last
-            out[:, d] += 0.5 * g * (since * since)[:, None]
+            fall = spans_many(since, drag)[1] if drag != 0.0 else 0.5 * (since * since)
+            out[:, d] += g * fall[:, None]
         if self.box.periodic and not unwrapped:
             out = self.box.wrap(out)
         return out

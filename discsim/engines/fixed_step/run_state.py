@@ -112,8 +112,9 @@ class FixedStepRun:
             arrays[name] = array
         shapes = self._shapes
         self._paths = Paths(
-            self.box, **arrays, gravity=shapes.gravity, falls=shapes.falls, angle_time=float(state.time)
-        )
+            self.box, **arrays, gravity=shapes.gravity, falls=shapes.falls, angle_time=float(state.time),
+            drag=shapes.drag,
+        )  # fmt: skip
         self._tally = Tally(state.counts, state.max_overlap, state.virial, state.dissipated)
         built = state.list_builds > 0 and len(state.list_positions) == n  # not after add_discs / remove_discs
         self._broad.load(state.list_positions, state.list_i, state.list_j, built=built)

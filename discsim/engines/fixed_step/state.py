@@ -32,14 +32,15 @@ class FixedStepState(EngineState):
         max_overlap: the deepest disc-disc overlap seen, as a fraction of the contact distance.
         virial: the sum over the disc-disc impulses applied since the start of ``dp_i . (r_i - r_j)``
             (energy; ``FixedStep.pressure()``); NaN when unknown (a version 1 state: see below).
-        dissipated: the kinetic energy taken by responses with restitution below 1 (``FixedStep.dissipated``).
+        dissipated: the kinetic energy taken by responses with restitution below 1 (or rough), and by the drag
+            over the flights the frames and edits ended (``FixedStep.dissipated`` adds the flights under way).
 
     Arrays:
         ref_positions ``(N, 2)``, velocities ``(N, 2)``, ref_times ``(N,)``:
             disc ``i`` is at ``ref_positions[i] + velocities[i] (t - ref_times[i])``
-            (lengths, length per time, times; not wrapped); under gravity a disc of finite mass follows the
-            parabola from there (``discsim.physics.dynamics.advance``), ``velocities[i]`` its velocity at
-            ``ref_times[i]``.
+            (lengths, length per time, times; not wrapped); under gravity or drag a disc of finite mass follows
+            the parabola or the exponential flight from there (``discsim.physics.dynamics.advance``),
+            ``velocities[i]`` its velocity at ``ref_times[i]``.
         images ``(N, 2)`` int64: box lengths to add to ``ref_positions`` to unwrap them
             (zero in a walled box).
         frame_positions ``(N, 2)``: the positions at ``frame_time``, wrapped into a periodic box.

@@ -259,7 +259,7 @@ def test_a_checkpoint_with_unreadable_laws_is_refused(tmp_path):
 @pytest.mark.parametrize("policy", FRAME_POLICIES)
 def test_the_bouncing_ball_case_shows_what_stepping_costs(policy):
     case = ds.scenarios.bouncing_ball()
-    assert [c.name for c in ds.scenarios.law_cases()] == [case.name]
+    assert ds.scenarios.law_cases()[0].name == case.name
     assert hash(case) != hash(ds.scenarios.delay())  # hashable, as the cases were before they had laws
     e, g = case.laws["restitution"], -case.laws["gravity"][1]
     h0 = float(case.discs.positions[0, 1] - case.discs.radii[0])

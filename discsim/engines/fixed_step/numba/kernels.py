@@ -149,7 +149,7 @@ def _walls(
 ):
     """Discs past a wall and moving outwards: reverse the normal velocity (with restitution and roughness);
     returns ``(k, ev_n, ev_f)``."""
-    _, _, _, e0, per_group, table, group, tc, last, lost = laws
+    _, _, _, _, e0, per_group, table, group, tc, last, lost = laws
     beta, inertia, spins, angles, angle_t = turning
     rough = beta != -1.0
     for i in range(len(pos)):
@@ -232,7 +232,7 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e, w, m, inert
 @jit
 def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws, turning):
     """Discs cutting a segment, each answered by :func:`_off_segments`; returns ``(k, ev_n, ev_f)``."""
-    _, _, _, e0, per_group, table, group, tc, last, lost = laws
+    _, _, _, _, e0, per_group, table, group, tc, last, lost = laws
     beta, inertia, spins, angles, angle_t = turning
     rough = beta != -1.0
     cut = np.empty(len(segments), dtype=np.int64)
@@ -507,7 +507,7 @@ def _pairs(policy, keys, pos, prev, paths, t, scene, changed, flown, ev_n, ev_f,
     """
     ref_pos, vel, ref_t, _ = paths
     radii, masses, periodic, width, height, _, _, _, _ = scene
-    _, _, _, e0, per_group, table, group, tc, last, lost = laws
+    _, _, _, _, e0, per_group, table, group, tc, last, lost = laws
     beta, inertia, spins, angles, angle_t = turning
     rough = beta != -1.0
     n = len(pos)
@@ -584,12 +584,16 @@ def _frame(
     ref_pos, vel, ref_t, images = paths
     radii, masses, periodic, width, height, segments, group, blocked, filtering = scene
     all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y = broad
-    gx, gy, falls = laws[0], laws[1], laws[2]
-    falling = gx != 0.0 or gy != 0.0  # (spares the free-flight loop a read of falls per disc)
+    gx, gy, drag, falls, lost = laws[0], laws[1], laws[2], laws[3], laws[10]
+    falling = gx != 0.0 or gy != 0.0 or drag != 0.0  # (spares the free-flight loop a read of falls per disc)
     n = len(ref_pos)
     for i in range(n):  # Paths.flown and Paths.fall, then Box.wrap
-        if falling and falls[i]:  # under gravity: along the parabola, and a new path from the frame
-            x, y, vx, vy = advance(ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1], t - ref_t[i], gx, gy)
+        if falling and falls[i]:  # under gravity or drag: along the exact path, and a new path from the frame
+            x0, y0, vx0, vy0 = ref_pos[i, 0], ref_pos[i, 1], vel[i, 0], vel[i, 1]
+            x, y, vx, vy = advance(x0, y0, vx0, vy0, t - ref_t[i], gx, gy, drag)
+            if drag != 0.0:  # what the drag took since the last frame (Paths.drag_loss, Tally.lose)
+                kinetic = 0.5 * ((vx0 * vx0 + vy0 * vy0) - (vx * vx + vy * vy))
+                lost[0] += masses[i] * (kinetic + gx * (x - x0) + gy * (y - y0))
             vel[i, 0], vel[i, 1] = vx, vy
             ref_pos[i, 0], ref_pos[i, 1] = x, y
             ref_t[i] = t
@@ -665,11 +669,11 @@ def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws, tu
             per unit length).
         counts: the counters (int64, changed in place). overlap: the deepest overlap seen so far.
         virial: the collision virial so far (``Tally.virial``).
-        laws: ``(gx, gy, falls, e, per_group, e_table, e_group, tc, last_collision, lost)``: gravity, the
-            discs it moves ``(N,)`` bool, the arguments of :func:`~discsim.engines.fixed_step.parts.restitution`
-            (``Shapes``' ``e``, ``per_group``, ``e_table`` ``(G, G)``, ``e_group`` ``(N,)`` int64, ``tc``, and
-            ``Paths.last_collision``, changed in place), and ``lost`` ``(1,)``: ``Tally.dissipated``, added to
-            in place.
+        laws: ``(gx, gy, drag, falls, e, per_group, e_table, e_group, tc, last_collision, lost)``: gravity, the
+            drag, the discs they move ``(N,)`` bool, the arguments of
+            :func:`~discsim.engines.fixed_step.parts.restitution` (``Shapes``' ``e``, ``per_group``, ``e_table``
+            ``(G, G)``, ``e_group`` ``(N,)`` int64, ``tc``, and ``Paths.last_collision``, changed in place), and
+            ``lost`` ``(1,)``: ``Tally.dissipated``, added to in place (the responses' losses and the drag's).
         turning: ``(beta, inertia, spins, angles, angle_times)``: the roughness (-1: smooth, the rest unread), the
             moments of inertia ``(N,)``, and ``Paths.spins``, ``angles``, ``angle_times`` (changed in place).
 

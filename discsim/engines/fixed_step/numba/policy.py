@@ -60,12 +60,13 @@ def _scene_arrays(shapes: Shapes) -> tuple:
 
 
 def _law_arrays(shapes: Shapes) -> tuple:
-    """The first eight slots of the ``laws`` argument of the compiled frames: gravity, the discs it moves, and
-    the restitution (the last two, ``Paths.last_collision`` and the energy lost, come with each call)."""
+    """The first nine slots of the ``laws`` argument of the compiled frames: gravity, the drag, the discs they move,
+    and the restitution (the last two, ``Paths.last_collision`` and the energy lost, come with each call)."""
     gx, gy = shapes.gravity
     return (
         float(gx),
         float(gy),
+        float(shapes.drag),
         np.ascontiguousarray(shapes.falls, dtype=np.bool_),
         float(shapes.e),
         bool(shapes.per_group),
@@ -203,7 +204,7 @@ class CompiledSubFrame(Policy):
         self._sub = (moving, float(shapes.diameter), float(tol), 2.0, isinstance(broad, AllPairs))
         self._counts = np.zeros(5, dtype=np.int64)
         self._acc = np.zeros(3)
-        self._laws = _law_arrays(shapes)[3:]  # the restitution (the sub-frame policies refuse gravity)
+        self._laws = _law_arrays(shapes)[4:]  # the restitution (the sub-frame policies refuse gravity and drag)
         self._beta, self._inertia = _turning_arrays(shapes)
         self._jam = np.zeros(3, dtype=np.int64)
         self._swept = Swept(shapes, broad) if name == "swept" else None

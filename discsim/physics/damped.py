@@ -15,7 +15,8 @@ with the two spans ``tau(t) = (1 - e^(-gamma t)) / gamma`` and ``s(t) = (t - tau
   (:func:`time_of_span`; none when ``gamma tau >= 1``).
 - With gravity, a coordinate along gravity is a sum of an exponential and a line, with one sign of curvature
   (``x'' = (a - gamma v) e^(-gamma t)``): at most one turn, so at most two monotone pieces, each holding at most
-  one crossing of a line, which :func:`_root` brackets and closes in on to adjacent floats
+  one crossing of a line, which :func:`_root` closes in on (Newton's method from the safe side, then bisection)
+  to adjacent floats
   (:func:`damped_exit`).
 - A falling disc against something that does not fall (an obstacle, a disc at rest, a segment's end point) has
   no closed form: :func:`damped_time_of_impact` advances in time by steps that a certified lower bound of
@@ -40,6 +41,8 @@ __all__ = ["PARTS", "damped_exit", "damped_time_of_impact", "spans", "spans_many
 INF = math.inf
 #: Below this ``|gamma t|`` the span ``s`` comes from its series (``t - tau`` would cancel); above, directly.
 _SERIES = 0.5
+#: Times beyond this count as never (the positions there overflow the floats).
+_NEVER = 1e250
 #: The most steps :func:`damped_time_of_impact` takes; far more than any case of the tests needs (tens).
 _MAX_STEPS = 2000
 
@@ -124,49 +127,81 @@ def _position(t: float, x: float, v: float, a: float, gamma: float) -> tuple[flo
 
 
 def _root(lo: float, hi: float, x: float, v: float, a: float, gamma: float, line: float) -> float:
-    """The time in ``(lo, hi]`` at which the coordinate ``x(t)``, below ``line`` at ``lo`` and at or above it at
-    ``hi`` (one crossing between), reaches ``line``: the upper of two adjacent floats bracketing it.
+    """The time in ``(lo, hi]`` at which the rising coordinate ``x(t)``, below ``line`` at ``lo`` and at or above
+    it at ``hi`` (one crossing between), reaches ``line``: the upper of two adjacent floats bracketing it.
 
-    Regula falsi with the Illinois modification (the end kept twice has its value halved), which closes the
-    bracket from both sides superlinearly, and a bisection whenever the secant falls outside.
+    ``x'' = (a - gamma v) e^(-gamma t)`` keeps one sign, so Newton's step from the end whose tangent stays on
+    the near side of the root (the lower end of a concave rise, the upper end of a convex one) closes in
+    monotonically and fast; the far end is then brought within a few steps of it, and bisection ends on two
+    adjacent floats.
     """
-    g_lo = _position(lo, x, v, a, gamma)[0] - line
-    g_hi = _position(hi, x, v, a, gamma)[0] - line
-    kept = 0
-    for _ in range(400):
-        t = hi - g_hi * (hi - lo) / (g_hi - g_lo)
-        if not lo < t < hi:
-            t = 0.5 * (lo + hi)
-            if not lo < t < hi:
-                return hi
-        g = _position(t, x, v, a, gamma)[0] - line
-        if g < 0.0:
-            lo, g_lo = t, g
-            if kept == 1:
-                g_hi *= 0.5
-            kept = 1
+    below = a - gamma * v < 0.0  # concave: Newton from the lower end
+    step = 0.0
+    for _ in range(100):
+        t = lo if below else hi
+        p, u = _position(t, x, v, a, gamma)
+        if not u > 0.0:
+            break
+        n = t - (p - line) / u
+        if not lo < n < hi:
+            break
+        step = abs(n - t)
+        if _position(n, x, v, a, gamma)[0] < line:
+            lo = n
+            if not below:  # roundoff put the step past the root: the bracket is as tight as it gets
+                break
         else:
-            hi, g_hi = t, g
-            if kept == -1:
-                g_lo *= 0.5
-            kept = -1
-    return hi
+            hi = n
+            if below:
+                break
+    # The far end: Newton's last point is within a few ulps of the root (quadratic convergence), so probe from 4
+    # ulps outwards, 8 times wider each time (a Newton cut short by the bracket just takes more probes).
+    width = 1e-15 * max(abs(lo), abs(hi) if hi < INF else 0.0, step * 1e-15) + 1e-300
+    for _ in range(400):
+        if below:
+            c = lo + width
+            if not c < hi:
+                break
+            if _position(c, x, v, a, gamma)[0] >= line:
+                hi = c
+                break
+            lo = c
+        else:
+            c = hi - width
+            if not c > lo:
+                break
+            if _position(c, x, v, a, gamma)[0] < line:
+                lo = c
+                break
+            hi = c
+        width *= 8.0
+    while True:
+        t = 0.5 * (lo + hi)
+        if not lo < t < hi:
+            return hi
+        if _position(t, x, v, a, gamma)[0] < line:
+            lo = t
+        else:
+            hi = t
 
 
 def _rising_root(start: float, x: float, v: float, a: float, gamma: float, line: float) -> float:
     """The time after ``start`` at which a coordinate under ``a > 0`` (rising from ``start`` on, below ``line``
     there) reaches ``line``, or ``inf`` if not within the floats (an acceleration too small to matter).
 
-    Bracketed by two lower bounds of the path after ``start`` (``u`` its velocity there, ``v_T = a / gamma`` the
-    terminal velocity, ``dt`` the time since): ``x(start) + v_T dt - max(0, v_T - u) / gamma``, and ``x(start) +
-    u tau(dt)`` (the acceleration only adds); then :func:`_root`."""
+    Bracketed by two lower bounds of the path after ``start`` (``u >= 0`` its velocity there, ``v_T = a / gamma``
+    the terminal velocity, ``dt`` the time since): ``x(start) + v_T dt - max(0, v_T - u) / gamma`` (tight when the
+    drag dominates), and ``x(start) + u tau + a tau^2 / 2`` (``tau = tau(dt)``; since ``s >= tau^2 / 2``: tight
+    when the drag is weak, as the parabola's root); then :func:`_root`."""
     q, u = _position(start, x, v, a, gamma)
+    u = max(u, 0.0)
     vt = a / gamma
     end = start + (line - q + max(0.0, vt - u) / gamma) / vt * (1.0 + 1e-9)
-    if u > 0.0:
-        end = min(end, start + time_of_span((line - q) / u, gamma) * (1.0 + 1e-9))
+    rise = line - q
+    tau = 2.0 * rise / (u + math.sqrt(u * u + 2.0 * a * rise))  # u tau + a tau^2 / 2 = rise
+    end = min(end, start + time_of_span(tau, gamma) * (1.0 + 1e-9))
     end += 1e-300
-    if not end < INF:
+    if not end < _NEVER:  # (an acceleration so small that the crossing lies beyond any time that can matter)
         return INF
     while _position(end, x, v, a, gamma)[0] < line:  # the bounds hold: only roundoff can leave it short
         end = start + 2.0 * (end - start)

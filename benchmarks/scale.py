@@ -1,7 +1,10 @@
 """Speed at scale: collisions per second of the compiled backend against N, for four gases (issue 32).
 
-Run ``python benchmarks/scale.py`` (about 6 minutes on 2 shared cores), ``--huge`` to add N = 10^7 (about
-10 minutes more and 3 GB of memory per run at most), ``--sizes 1000 10000`` for some sizes only, or ``--quick``
+Run ``python benchmarks/scale.py`` (4 to 5 minutes on this project's 2 shared cores: 3 runs per point, 1 at
+N = 10^6), ``--huge`` to add N = 10^7 (measured here for ``mono 0.3`` alone, ``--huge --sizes 10000000
+--gases "mono 0.3" --repeats 1 --stem scale_huge``: 3 minutes, most of it building the engine, and 4.3 GB of
+peak memory; the mixture's construction at 10^6 already peaks at 1.8 GB, so the four gases at 10^7 were
+not tried on this 23 GB machine), ``--sizes 1000 10000`` for some sizes only, or ``--quick``
 (seconds: proves the script runs).
 
 For each gas and N, a seeded periodic gas is built through the public API (``import discsim as ds``), run
@@ -18,17 +21,20 @@ points. The gases (``GASES``):
 
 Figures, as printed and written to ``scale.csv`` (and ``scale.png``: rate against N, one line per gas):
 
-* ``coll/s``: median over the repeats of the timed collisions per wall-clock second (``min``, ``max`` in
-  the CSV: the machine's noise); ``coll/CPU s``: the same per CPU second of the run's process
+* ``coll/s``: median over the repeats of the timed collisions per wall-clock second (``rate_min``,
+  ``rate_max`` in the CSV: the machine's noise); ``coll/CPU s``: the same per CPU second of the run's process
   (``time.process_time``: a wait for memory counts, another process's turn on the core does not), steadier
-  than wall-clock time on a shared machine;
-* ``/mono 1e4``: that rate over the rate of ``mono 0.3`` at N = 10^4 (issue 32's targets: at least 0.7 for
-  the monodisperse gases at 10^6, 0.5 at 10^7; at least 0.8 for the mixtures at 10^4 and 10^5 against
-  ``mono 0.3`` at the same N, ``/mono same N`` in the CSV);
-* ``B/disc``: bytes the engine holds per disc once built and started (``tracemalloc``'s traced memory after
-  building the ``EventDriven``, less before; numpy reports its buffers to tracemalloc): every array of the
-  engine, the backend's state and the scene's copy of the discs alike; ``peak MB``: the process's peak
-  resident memory (the interpreter and numba included).
+  than wall-clock time on a shared machine, and the rate the ratios and the figure use;
+* ``/mono 1e4``: that CPU rate over the CPU rate of ``mono 0.3`` at N = 10^4 (issue 32's targets: at least 0.7
+  for the monodisperse gases at 10^6, 0.5 at 10^7); ``/mono same N``: over ``mono 0.3`` at the same N (the
+  targets: at least 0.8 for the mixtures at 10^4 and 10^5); the CSV has both from wall-clock rates too
+  (``*_wall``);
+* ``B/disc``: bytes of the compiled backend's state arrays per disc (its ``nbytes()``, as
+  ``benchmarks/backends.py`` reports them: the one read past the public API); ``RSS B/disc``: growth of the
+  process's resident memory from before building the ``EventDriven`` to its first event, per disc (every array
+  the engine holds, the scene's copy of the discs included; coarse: memory the gas's construction freed is
+  used again, so small N and the mixture read low); ``peak MB``: the process's peak resident memory
+  (the interpreter, numba and the gas's construction included).
 
 Figures only: nothing here asserts a speed.
 """
@@ -78,23 +84,33 @@ def build(gas: str, n: int, seed: int):
     return mixture(n, packing, seed)
 
 
+def resident_bytes() -> int:
+    """This process's resident memory now, in bytes (0 where ``/proc`` is missing)."""
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) * 1024  # kB
+    except OSError:
+        pass
+    return 0
+
+
 def measure(gas: str, n: int, seed: int, timed: int) -> dict:
     """One run (call it in a fresh process): build, start, warm up, time ``timed`` collisions."""
-    import tracemalloc
-
     from benchutils import peak_resident_mb
 
     import discsim as ds
 
-    # Load (or compile) the loop first, on a small gas of the same kind, so that the traced memory is the run's.
+    # Load (or compile) the loop first, on a small gas of the same kind, so that the memory measured is the run's.
     ds.EventDriven(*build(gas, 1_000, seed), record=False, backend="numba").run(events=1)
     discs, box = build(gas, n, seed)
-    tracemalloc.start()
-    before = tracemalloc.get_traced_memory()[0]
+    before = resident_bytes()
     sim = ds.EventDriven(discs, box, record=False, backend="numba")
     sim.run(events=1)  # the backend is built and every disc predicted
-    held = tracemalloc.get_traced_memory()[0] - before
-    tracemalloc.stop()
+    resident = resident_bytes() - before
+    # The one read past the public API (as benchmarks/backends.py): the bytes of the backend's state arrays.
+    arrays = sim._backend.nbytes()
     sim.run(events=min(WARMUP_MAX, WARMUP_PER_DISC * n))
     start_count = sim.counts["collisions"]
     start, cpu = time.perf_counter(), time.process_time()
@@ -106,7 +122,8 @@ def measure(gas: str, n: int, seed: int, timed: int) -> dict:
         "seconds": seconds,
         "rate": collisions / seconds,
         "cpu_rate": collisions / cpu,
-        "bytes_per_disc": held / n,
+        "bytes_per_disc": arrays / n,
+        "resident_per_disc": resident / n,
         "peak_mb": peak_resident_mb(),
     }
 
@@ -137,17 +154,21 @@ def run_points(
                 "rate_min": min(rates),
                 "rate_max": max(rates),
                 "cpu_rate": median([r["cpu_rate"] for r in done]),
+                "cpu_rate_min": min(r["cpu_rate"] for r in done),
+                "cpu_rate_max": max(r["cpu_rate"] for r in done),
                 "bytes_per_disc": median([r["bytes_per_disc"] for r in done]),
+                "resident_per_disc": median([r["resident_per_disc"] for r in done]),
                 "peak_mb": max(r["peak_mb"] for r in done),
                 "collisions": timed,
                 "runs": len(done),
             }
         )
-    by_point = {(r["gas"], r["n"]): r["rate"] for r in rows}
-    reference = by_point.get(REFERENCE, float("nan"))
-    for row in rows:
-        row["over_reference"] = row["rate"] / reference
-        row["over_mono_same_n"] = row["rate"] / by_point.get(("mono 0.3", row["n"]), float("nan"))
+    for key, suffix in (("cpu_rate", ""), ("rate", "_wall")):
+        by_point = {(r["gas"], r["n"]): r[key] for r in rows}
+        reference = by_point.get(REFERENCE, float("nan"))
+        for row in rows:
+            row[f"over_reference{suffix}"] = row[key] / reference
+            row[f"over_mono_same_n{suffix}"] = row[key] / by_point.get(("mono 0.3", row["n"]), float("nan"))
     return rows
 
 
@@ -159,6 +180,7 @@ COLUMNS = [
     Column("over_reference", "/mono 1e4", ".2f"),
     Column("over_mono_same_n", "/mono same N", ".2f"),
     Column("bytes_per_disc", "B/disc", ".0f"),
+    Column("resident_per_disc", "RSS B/disc", ".0f"),
     Column("peak_mb", "peak MB", ".0f"),
 ]
 CSV_KEYS = [
@@ -169,9 +191,14 @@ CSV_KEYS = [
     "rate_min",
     "rate_max",
     "cpu_rate",
+    "cpu_rate_min",
+    "cpu_rate_max",
     "over_reference",
     "over_mono_same_n",
+    "over_reference_wall",
+    "over_mono_same_n_wall",
     "bytes_per_disc",
+    "resident_per_disc",
     "peak_mb",
     "collisions",
     "runs",
@@ -179,7 +206,8 @@ CSV_KEYS = [
 
 
 def plot(rows: Sequence[dict], path: Path, title: str) -> Path:
-    """Rate against N (log-log), one line per gas, with the min-max band of the repeats."""
+    """Rate against N (log x), one line per gas: per CPU second (solid, with the min-max band of the repeats)
+    and per wall-clock second (dashed)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -189,11 +217,12 @@ def plot(rows: Sequence[dict], path: Path, title: str) -> Path:
     for gas in dict.fromkeys(r["gas"] for r in rows):
         mine = sorted((r for r in rows if r["gas"] == gas), key=lambda r: r["n"])
         ns = [r["n"] for r in mine]
-        ax.plot(ns, [r["rate"] for r in mine], marker="o", label=gas)
-        ax.fill_between(ns, [r["rate_min"] for r in mine], [r["rate_max"] for r in mine], alpha=0.2)
+        (line,) = ax.plot(ns, [r["cpu_rate"] for r in mine], marker="o", label=gas)
+        ax.fill_between(ns, [r["cpu_rate_min"] for r in mine], [r["cpu_rate_max"] for r in mine], alpha=0.2)
+        ax.plot(ns, [r["rate"] for r in mine], linestyle="--", color=line.get_color(), alpha=0.6)
     ax.set_xscale("log")
     ax.set_xlabel("N (discs)")
-    ax.set_ylabel("collisions per second (median)")
+    ax.set_ylabel("collisions per CPU second (dashed: per wall s)")
     ax.set_ylim(bottom=0)
     ax.set_title(title, fontsize=9)
     ax.grid(True, which="both", alpha=0.3)

@@ -287,7 +287,9 @@ def test_scale_script_writes_a_row_per_gas_and_size_and_its_plot(tmp_path):
     assert [(row["gas"], int(row["n"])) for row in rows] == [("mono 0.3", 1000), ("uniform 0.3", 1000)]
     for row in rows:
         assert float(row["rate"]) > 0 and 0 < float(row["rate_min"]) <= float(row["rate_max"])
-        assert float(row["over_mono_same_n"]) == pytest.approx(float(row["rate"]) / float(rows[0]["rate"]))
+        assert float(row["cpu_rate_min"]) <= float(row["cpu_rate"]) <= float(row["cpu_rate_max"])
+        assert float(row["over_mono_same_n"]) == pytest.approx(float(row["cpu_rate"]) / float(rows[0]["cpu_rate"]))
+        assert float(row["over_mono_same_n_wall"]) == pytest.approx(float(row["rate"]) / float(rows[0]["rate"]))
         assert 64 < float(row["bytes_per_disc"]) < 10_000  # the engine's arrays, not numba's compiler
     assert (tmp_path / "scale.png").stat().st_size > 0
 

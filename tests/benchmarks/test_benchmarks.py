@@ -277,3 +277,31 @@ def test_backends_script_writes_both_backends_side_by_side(tmp_path):
         ("warm", "visible"),
         ("warm", "hidden"),
     }
+
+
+@pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
+def test_scale_script_writes_a_row_per_gas_and_size_and_its_plot(tmp_path):
+    done = run_quick("scale.py", tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(tmp_path / "scale.csv")
+    assert [(row["gas"], int(row["n"])) for row in rows] == [("mono 0.3", 1000), ("uniform 0.3", 1000)]
+    for row in rows:
+        assert float(row["rate"]) > 0 and 0 < float(row["rate_min"]) <= float(row["rate_max"])
+        assert float(row["cpu_rate_min"]) <= float(row["cpu_rate"]) <= float(row["cpu_rate_max"])
+        assert float(row["over_mono_same_n"]) == pytest.approx(float(row["cpu_rate"]) / float(rows[0]["cpu_rate"]))
+        assert float(row["over_mono_same_n_wall"]) == pytest.approx(float(row["rate"]) / float(rows[0]["rate"]))
+        assert 64 < float(row["bytes_per_disc"]) < 10_000  # the engine's arrays, not numba's compiler
+    assert (tmp_path / "scale.png").stat().st_size > 0
+
+
+@pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
+def test_memory_order_script_writes_each_order(tmp_path):
+    done = run_quick("memory_order.py", tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(tmp_path / "memory_order.csv")
+    assert [row["order"] for row in rows] == ["start", "shuffled", "resorted", "morton"]
+    assert all(float(row["rate"]) > 0 for row in rows)
+    assert float(rows[0]["over_start"]) == 1.0
+    (ties,) = read_csv(tmp_path / "memory_order_ties.csv")
+    # a renumbered engine logs the same events, but for the roles of a pair's discs in exact ties
+    assert int(ties["differ"]) == int(ties["roles_swapped"]) and ties["same_state"] == "True"

@@ -14,7 +14,7 @@ from discsim.cells import CellGrid
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.scene import Scene
 
-__all__ = ["RENUMBER_MIN", "TILE", "fresh_state", "internal_order"]
+__all__ = ["RENUMBER_MIN", "TILE", "cell_order", "fresh_state", "internal_order"]
 
 #: Side, in cells, of the square tiles by which large systems are numbered (see :func:`internal_order`).
 TILE = 10
@@ -35,11 +35,21 @@ def internal_order(grid: CellGrid, positions: np.ndarray) -> np.ndarray:
     """
     if not len(positions):
         return np.zeros(0, dtype=np.int64)
-    cx, cy = np.divmod(grid.cells_of(positions), grid.ny)
+    return cell_order(grid, grid.cells_of(positions))
+
+
+def cell_order(grid: CellGrid, cells: np.ndarray, before: np.ndarray | None = None) -> np.ndarray:
+    """The discs in cells ``cells`` (``(N,)`` cell indices) ordered tile by tile, as :func:`internal_order`.
+
+    Within a cell the discs keep the order of ``before`` (``(N,)``, a permutation of the discs; default
+    ``arange(N)``). Returns ``order``, ``(N,)``: disc ``order[k]`` comes k-th.
+    """
+    before = np.arange(len(cells)) if before is None else np.asarray(before)
+    cx, cy = np.divmod(np.asarray(cells)[before], grid.ny)
     tiles_y = -(-grid.ny // TILE)
     tile = (cx // TILE) * tiles_y + cy // TILE
     key = (tile * TILE + cx % TILE) * TILE + cy % TILE
-    return np.argsort(key, kind="stable").astype(np.int64)
+    return before[np.argsort(key, kind="stable")].astype(np.int64)
 
 
 def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:

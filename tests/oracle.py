@@ -123,3 +123,24 @@ def next_event_under_gravity(positions, velocities, radii, masses, box, gravity,
                     if t < best[0]:
                         best = (t, "wall", i, -1)
     return best
+
+
+def scattered_discs(n, size, radii, speed, obstacles, seed=11):
+    """``n`` discs at random places in a ``size`` x ``size`` walled box, none overlapping: radii uniform in
+    ``radii`` ``(lo, hi)``, masses in [0.5, 2], velocities normal with scale ``speed``; the first ``obstacles`` of
+    them obstacles (infinite mass, at rest). For the oracle tests in lock-step."""
+    import discsim as ds
+
+    rng = np.random.default_rng(seed)
+    pos, rad = [], []
+    while len(pos) < n:
+        r = rng.uniform(*radii)
+        p = rng.uniform(r, size - r, size=2)
+        if all(np.hypot(*(p - q)) > r + s + 1e-6 for q, s in zip(pos, rad)):
+            pos.append(p)
+            rad.append(r)
+    masses = rng.uniform(0.5, 2.0, size=n)
+    masses[:obstacles] = np.inf
+    vel = rng.normal(scale=speed, size=(n, 2))
+    vel[:obstacles] = 0.0
+    return ds.Discs(np.array(pos), vel, np.array(rad), masses)

@@ -132,19 +132,9 @@ def next_event_under_drag(pos, vel, radii, masses, box, gravity, gamma, resting)
 
 @pytest.mark.parametrize("gravity", [(0.0, 0.0), (0.5, -3.0)])
 def test_a_gas_under_drag_follows_the_oracle(every_backend, gravity):
-    rng = np.random.default_rng(11)
-    pos, rad = [], []
-    while len(pos) < 10:
-        r = rng.uniform(0.5, 0.9)
-        p = rng.uniform(r, 10.0 - r, size=2)
-        if all(np.hypot(*(p - q)) > r + s + 1e-6 for q, s in zip(pos, rad)):
-            pos.append(p)
-            rad.append(r)
-    masses = rng.uniform(0.5, 2.0, size=10)
-    masses[:2] = np.inf
-    vel = rng.normal(scale=4.0, size=(10, 2))
-    vel[:2] = 0.0
-    discs = ds.Discs(np.array(pos), vel, np.array(rad), masses)
+    from oracle import scattered_discs
+
+    discs = scattered_discs(10, 10.0, (0.5, 0.9), 4.0, obstacles=2)
     sim = ds.EventDriven(discs, BOX, gravity=gravity, drag=0.2, restitution=0.9)
     assert sim.backend == every_backend
     for _ in range(40):

@@ -270,21 +270,9 @@ def test_pressure_under_gravity_is_refused_with_a_reason():
 # --- the brute-force oracle, in lock-step ----------------------------------------------------------------------
 @pytest.mark.parametrize("restitution", [1.0, 0.7])
 def test_a_gas_under_gravity_follows_the_oracle(every_backend, restitution):
-    from oracle import next_event_under_gravity
+    from oracle import next_event_under_gravity, scattered_discs
 
-    rng = np.random.default_rng(11)
-    pos, rad = [], []
-    while len(pos) < 16:
-        r = rng.uniform(0.4, 0.9)
-        p = rng.uniform(r, 12.0 - r, size=2)
-        if all(np.hypot(*(p - q)) > r + s + 1e-6 for q, s in zip(pos, rad)):
-            pos.append(p)
-            rad.append(r)
-    masses = rng.uniform(0.5, 2.0, size=16)
-    masses[:3] = np.inf
-    vel = rng.normal(scale=2.0, size=(16, 2))
-    vel[:3] = 0.0
-    discs = ds.Discs(np.array(pos), vel, np.array(rad), masses)
+    discs = scattered_discs(16, 12.0, (0.4, 0.9), 2.0, obstacles=3)
     sim = ds.EventDriven(discs, ds.Box(12.0, 12.0), gravity=(0.5, -3.0), restitution=restitution)
     for _ in range(150):
         t0 = sim.time

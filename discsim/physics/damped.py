@@ -136,7 +136,7 @@ def _root(lo: float, hi: float, x: float, v: float, a: float, gamma: float, line
     adjacent floats.
     """
     below = a - gamma * v < 0.0  # concave: Newton from the lower end
-    step = 0.0
+    near_low = below  # which end the root is nearest now
     for _ in range(100):
         t = lo if below else hi
         p, u = _position(t, x, v, a, gamma)
@@ -145,20 +145,21 @@ def _root(lo: float, hi: float, x: float, v: float, a: float, gamma: float, line
         n = t - (p - line) / u
         if not lo < n < hi:
             break
-        step = abs(n - t)
         if _position(n, x, v, a, gamma)[0] < line:
             lo = n
-            if not below:  # roundoff put the step past the root: the bracket is as tight as it gets
+            if not below:  # roundoff put the step past the root, a few ulps from it: stop there
+                near_low = True
                 break
         else:
             hi = n
             if below:
+                near_low = False
                 break
-    # The far end: Newton's last point is within a few ulps of the root (quadratic convergence), so probe from 4
+    # The far end: the near one is within a few ulps of the root (Newton converges quadratically), so probe from 4
     # ulps outwards, 8 times wider each time (a Newton cut short by the bracket just takes more probes).
-    width = 1e-15 * max(abs(lo), abs(hi) if hi < INF else 0.0, step * 1e-15) + 1e-300
+    width = 1e-15 * abs(lo if near_low else hi) + 1e-300
     for _ in range(400):
-        if below:
+        if near_low:
             c = lo + width
             if not c < hi:
                 break

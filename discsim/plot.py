@@ -30,7 +30,7 @@ from matplotlib.patches import Circle, Rectangle
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, COLLISION
 from discsim.model import Discs, frame_count
-from discsim.trajectory import LastRecords, replay
+from discsim.trajectory import LastRecords, flight, replay
 
 __all__ = ["animate", "close", "plot_case", "plot_cases", "plot_state", "plot_trajectories", "save_figure"]
 
@@ -582,7 +582,9 @@ def animate(
         dynamic.append(discs)
         quiver = None
         if arrows:
-            speeds = replay([s.events], origin, times, s.box, velocities=True)[1]  # last recorded velocities
+            laws = getattr(s, "laws", None)  # under gravity the velocities change between records
+            gravity = flight(getattr(laws, "gravity", None), getattr(laws, "drag", 0.0), what="animate(arrows=True)")
+            speeds = replay([s.events], origin, times, s.box, velocities=True, gravity=gravity)[1]
             scale = _arrow_time(s.discs.radii, speeds.reshape(-1, 2)[np.isfinite(speeds.reshape(-1, 2)).all(axis=1)])
             quiver = _arrows(ax, np.nan_to_num(paths[0]), np.nan_to_num(speeds[0]) * 0.0, max(scale, 1e-300), colours)
             if quiver is not None:  # cut at the walls, as in plot_state

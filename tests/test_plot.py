@@ -228,6 +228,16 @@ def test_animate_draws_small_discs_large_with_the_clock_and_arrows_clear_of_them
     plot.close(whole)
 
 
+def test_animate_draws_the_velocity_of_a_falling_ball_at_each_frame(tmp_path):
+    sim = ds.EventDriven(ds.Discs([[2.0, 8.0]], [[1.0, 0.0]], 0.5), ds.Box(10.0, 10.0), gravity=(0.0, -9.81))
+    sim.run(until=1.0)  # no record yet: the log's velocity is the start's, (1, 0)
+    anim = plot.animate(sim, tmp_path / "fall.gif", arrows=True, max_frames=8, dpi=40)  # drawn to the last frame
+    (quiver,) = [c for c in anim._fig.axes[0].collections if isinstance(c, matplotlib.quiver.Quiver)]
+    arrow = np.array([quiver.U[0], quiver.V[0]])
+    np.testing.assert_allclose(arrow / np.hypot(*arrow), sim.velocities[0] / np.hypot(*sim.velocities[0]))
+    plot.close(anim)
+
+
 def test_state_figures_name_their_axes():
     ax = plot.plot_state(ds.Discs([[1.0, 1.0]], [[1.0, 0.0]], radii=0.5), box=ds.Box(4.0, 3.0))
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("x", "y")

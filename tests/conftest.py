@@ -36,3 +36,13 @@ def every_backend(request, monkeypatch):
     else:  # "auto" then runs even a short event-driven run compiled from its first event
         monkeypatch.setattr(_numba, "AUTO_PYTHON_EVENTS", 0)
     return request.param
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects by the marks
+def pytest_collection_modifyitems(items):
+    """A test marked ``slow_on_python`` is slow in its pure-Python backend's case only: mark that case ``slow`` (under
+    the laws both backends run one loop's source, the Python one interpreted, so its quick case is the compiled one)."""
+    for item in items:
+        callspec = getattr(item, "callspec", None)
+        if item.get_closest_marker("slow_on_python") and callspec and callspec.params.get("every_backend") == "python":
+            item.add_marker(pytest.mark.slow)

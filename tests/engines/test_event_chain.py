@@ -158,7 +158,7 @@ def test_the_structure_of_a_dense_liquid_is_the_event_driven_one():
     assert g_mc.contact_value(sigma) == pytest.approx(g_md.contact_value(sigma), rel=0.02)
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("backend", [pytest.param("python", marks=pytest.mark.slow), BACKENDS[1]])  # python: 12 s
 def test_the_lift_log_holds_every_lift_and_changes_nothing(backend, tmp_path):
     discs, box = ds.random_gas(150, 0.7, seed=4)
     ell = 3.0 * box.width  # long chains: hundreds of lifts each, past the first batch's room (64): it runs again

@@ -130,6 +130,7 @@ def next_event_under_drag(pos, vel, radii, masses, box, gravity, gamma, resting)
     return best
 
 
+@pytest.mark.slow_on_python
 @pytest.mark.parametrize("gravity", [(0.0, 0.0), (0.5, -3.0)])
 def test_a_gas_under_drag_follows_the_oracle(every_backend, gravity):
     from oracle import scattered_discs

@@ -179,6 +179,7 @@ def test_inelastic_collapse_ends_with_a_clear_error_never_a_hang(every_backend):
 
 
 # --- state, checkpoints, defaults, bad input ---------------------------------------------------------------
+@pytest.mark.slow_on_python
 def test_a_run_under_the_laws_continues_from_a_checkpoint_bit_for_bit(every_backend, tmp_path):
     discs, box = ds.random_gas(30, 0.3, seed=9)
     laws = {"gravity": (0.0, -2.0), "restitution": 0.9, "tc": 1e-3}
@@ -268,6 +269,7 @@ def test_pressure_under_gravity_is_refused_with_a_reason():
 
 
 # --- the brute-force oracle, in lock-step ----------------------------------------------------------------------
+@pytest.mark.slow_on_python
 @pytest.mark.parametrize("restitution", [1.0, 0.7])
 def test_a_gas_under_gravity_follows_the_oracle(every_backend, restitution):
     from oracle import next_event_under_gravity, scattered_discs
@@ -372,6 +374,7 @@ def test_a_log_streamed_from_mid_run_keeps_the_discs_at_rest_where_they_rest(tmp
     assert next(iter(ds.iter_events(path))).before.still.tolist() == [True, True, False]
 
 
+@pytest.mark.slow_on_python
 def test_a_periodic_fall_read_in_chunks_counts_the_box_lengths_along_the_parabolas(tmp_path):
     from discsim.trajectory import LastRecords, replay
 

@@ -54,6 +54,17 @@ def test_two_discs_meet_at_free_flights_contact_in_the_transformed_time(every_ba
     assert event.time == pytest.approx(-math.log1p(-gamma * 2.0) / gamma, rel=1e-13)
 
 
+@pytest.mark.parametrize("gamma", [1e-12, 1e-9])
+def test_a_ball_dropped_on_an_obstacle_under_a_tiny_drag_hits_it_at_contact_and_bounces(every_backend, gamma):
+    # Once hit "at" 1.5 its contact distance, 1e-4 into the fall, and came to rest there in mid-air.
+    discs = ds.Discs([[5.0, 3.0], [5.3, 6.0]], [[0.0, 0.0], [0.0, 0.0]], radii=1.0, masses=[np.inf, 1.0])
+    sim = ds.EventDriven(discs, BOX, gravity=(0.0, -G), drag=gamma, restitution=0.7)
+    event = sim.step()
+    assert event.kind == "collision" and event.time == pytest.approx(0.4566036043583582, rel=1e-9)
+    assert np.hypot(*(sim.positions[1] - sim.positions[0])) == pytest.approx(2.0, rel=1e-12)
+    assert not sim.resting.any() and sim.velocities[1, 1] > 0.0
+
+
 # --- the oracle -------------------------------------------------------------------------------------------------
 def _first(values_at, horizon):
     """The first time in (0, horizon] where ``values_at(t) <= 0``, by a dense grid and bisection (or inf)."""

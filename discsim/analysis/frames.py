@@ -212,11 +212,12 @@ def _log_source(source, what: str):
 
 
 def _refuse_gravity(engine, what: str) -> None:
-    """Refuse a run under gravity: the log's replay (:func:`discsim.trajectory.replay`) is free flight's."""
+    """Refuse a run under gravity or drag: the log's replay (:func:`discsim.trajectory.replay`) is free flight's."""
     laws = getattr(engine, "laws", None)
-    if laws is not None and laws.falls:
+    if laws is not None and (laws.falls or laws.drag != 0.0):
+        law = f"gravity {laws.gravity}" if laws.falls else f"drag {laws.drag}"
         msg = (
-            f"{what} replays free flight between events, and this run is under gravity {laws.gravity}: use "
+            f"{what} replays free flight between events, and this run is under {law}: use "
             "sim.trajectory(times) for exact positions, or sample the run with ds.Sampler(dt) while it runs"
         )
         raise InvalidArgumentError(msg)

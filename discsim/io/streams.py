@@ -37,8 +37,9 @@ DEFAULT_CHUNK = 65_536
 
 
 def stream_header(
-    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None, gravity=None
-) -> tuple[dict, dict]:
+    discs: Discs, box: Box, start_time: float, run_id: str, base: int, ids: np.ndarray | None = None, gravity=None,
+    drag: float = 0.0,
+) -> tuple[dict, dict]:  # fmt: skip
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
     Args:
@@ -49,6 +50,7 @@ def stream_header(
         ids: ``(N,)`` the discs' ids (``sim.ids``), stored only when given (None: their indices).
         gravity: the run's ``(gx, gy)``, stored when given: a replay of the log (free flight between records)
             then refuses to rebuild positions.
+        drag: the run's drag ``gamma`` (1 / time), stored when not 0: a replay refuses it as it does gravity.
     """
     meta = {
         "kind": STREAM_KIND,
@@ -60,6 +62,8 @@ def stream_header(
     }
     if gravity is not None:
         meta["gravity"] = [float(gravity[0]), float(gravity[1])]
+    if drag != 0.0:
+        meta["drag"] = float(drag)
     arrays = {
         "positions": discs.positions,
         "velocities": discs.velocities,
@@ -86,6 +90,7 @@ class StreamedEvents:
         run_id: the run that wrote the log.
         ids: ``(N,)`` the ids of ``discs`` (the names the records give them), or None: their indices.
         gravity: the run's ``(gx, gy)`` if it ran under gravity (then :meth:`trajectory` refuses), else None.
+        drag: the run's drag ``gamma`` (1 / time; not 0: :meth:`trajectory` refuses).
     """
 
     events: np.ndarray
@@ -96,6 +101,7 @@ class StreamedEvents:
     run_id: str
     ids: np.ndarray | None = None
     gravity: tuple | None = None
+    drag: float = 0.0
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -106,9 +112,9 @@ class StreamedEvents:
 
         Raises:
             TimeError: if a time is not finite or lies outside the logged span.
-            InvalidArgumentError: if the run was under gravity (its replay would be free flight's).
+            InvalidArgumentError: if the run was under gravity or drag (its replay would be free flight's).
         """
-        refuse_gravity("the streamed log", {"gravity": self.gravity})
+        refuse_gravity("the streamed log", {"gravity": self.gravity, "drag": self.drag})
         return positions_from_log(
             self.events,
             self.discs,
@@ -162,7 +168,15 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
     end_time = float(stream.last.get("time", start_time))
     gravity = stream.meta.get("gravity")
     return StreamedEvents(
-        stream.records, discs, box, start_time, end_time, run_id, ids, None if gravity is None else tuple(gravity)
+        stream.records,
+        discs,
+        box,
+        start_time,
+        end_time,
+        run_id,
+        ids,
+        None if gravity is None else tuple(gravity),
+        float(stream.meta.get("drag", 0.0)),
     )
 
 
@@ -320,15 +334,17 @@ def iter_events(
 
 
 def refuse_gravity(path, meta) -> None:
-    """Refuse to replay a log streamed under gravity: the replay is free flight's between records.
+    """Refuse to replay a log streamed under gravity or drag: the replay is free flight's between records.
 
     Raises:
-        InvalidArgumentError: naming the file and the gravity.
+        InvalidArgumentError: naming the file and the gravity (or the drag).
     """
     gravity = meta.get("gravity") if isinstance(meta, dict) else None
-    if gravity is not None:
+    drag = meta.get("drag") if isinstance(meta, dict) else None
+    if gravity is not None or drag:
+        law = f"gravity {tuple(gravity)}" if gravity is not None else f"drag {drag}"
         msg = (
-            f"{path}: this event log was streamed under gravity {tuple(gravity)}, and its replay is free flight's "
+            f"{path}: this event log was streamed under {law}, and its replay is free flight's "
             "between records: rebuild positions with sim.trajectory(times) while the run holds its log, or sample "
             "the run with ds.Sampler(dt)"
         )

@@ -199,7 +199,8 @@ class EventStream(Observer):
         run_id = context.ensure_run_id()
         laws = getattr(engine, "laws", None)
         gravity = laws.gravity if laws is not None and laws.falls else None
-        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids, gravity)
+        drag = laws.drag if laws is not None else 0.0
+        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids, gravity, drag)
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
         self._created = True
         context.stream = {

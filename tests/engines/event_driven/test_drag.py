@@ -188,6 +188,19 @@ def test_a_run_under_drag_continues_from_a_checkpoint_bit_for_bit(every_backend,
     assert resumed.dissipated == pytest.approx(whole.dissipated, rel=1e-12)
 
 
+def test_replays_of_free_flight_refuse_a_run_under_drag(tmp_path):
+    # They once replayed it as free flight: frames() put the disc at x = -8.3, outside the box.
+    sim = ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=0.5).run(until=5.0)
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.frames(sim, [2.5])
+    path = tmp_path / "events.dse"
+    ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=0.5, record=False).run(until=5.0, record_to=path)
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.trajectory_from_events(path, [2.5])
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.read_events(path).trajectory([2.5])
+
+
 def test_drag_zero_is_todays_physics():
     discs, box = ds.random_gas(30, 0.3, seed=1)
     plain = ds.EventDriven(discs, box, backend="python").run(events=300)

@@ -2,12 +2,13 @@
 energy bookkeeping, both backends bit for bit, trajectories, checkpoints, bad input."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
 import discsim as ds
-from discsim.errors import InvalidArgumentError
+from discsim.errors import InvalidArgumentError, UnitsError
 from discsim.physics.damped import spans_many
 
 G = 9.81
@@ -212,3 +213,20 @@ def test_drag_zero_is_todays_physics():
 def test_bad_drag_is_refused_naming_it(drag):
     with pytest.raises(InvalidArgumentError, match="drag"):
         ds.EventDriven(ball(5.0, 5.0), BOX, drag=drag)
+
+
+@pytest.mark.parametrize("drag", [5e-324, 1e-315, 1e-101, 1e101])
+def test_a_drag_outside_the_supported_units_is_refused_naming_it(drag):
+    # A subnormal drag once flew a disc through the wall: gamma t loses its digits, so tau(0.875) came out 1.
+    with pytest.raises(UnitsError, match=re.escape(f"drag {drag!r}")):
+        ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=drag)
+
+
+@pytest.mark.parametrize("drag", [1e-100, 1e100])
+def test_the_ends_of_the_drags_units_fly_as_no_drag_and_as_an_instant_stop(drag):
+    sim = ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=drag)
+    sim.run(until=1.5)
+    if drag < 1.0:
+        assert times(sim).tolist() == [0.875] and sim.positions[0].tolist() == [4.0, 5.0]
+    else:
+        assert times(sim).tolist() == [] and sim.positions[0] == pytest.approx([2.0 + 8.0 / drag, 5.0], abs=1e-15)

@@ -294,14 +294,18 @@ def damped_time_of_impact(
         # Over the span p' runs from p'(t) towards the terminal velocity, only as far as p'(t) + (a - gamma p'(t))
         # tau(span) (not all the way: a tiny drag's terminal velocity would make the bound useless, and the steps
         # tiny): the largest and the least |p'| over the span lie on that piece of the segment.
+        # p''(t) = a - gamma p'(t) = (a - gamma w) e^(-gamma t), written so: near the terminal velocity the
+        # difference is all roundoff, and would bound the curvature 1e16 times too high (a huge drag's steps).
+        decay = math.exp(-gamma * t)
+        cx, cy = (ax - gamma * dvx) * decay, (ay - gamma * dvy) * decay
         reached = -math.expm1(-gamma * span) / gamma
-        ex, ey = (ax - gamma * wx) * reached, (ay - gamma * wy) * reached
+        ex, ey = cx * reached, cy * reached
         w_big = max(math.hypot(wx, wy), math.hypot(wx + ex, wy + ey))
         ee = ex * ex + ey * ey
         k = 0.0 if ee == 0.0 else min(1.0, max(0.0, -(wx * ex + wy * ey) / ee))
         mx, my = wx + k * ex, wy + k * ey
         m = mx * mx + my * my
-        curve = math.hypot(ax - gamma * wx, ay - gamma * wy)
+        curve = math.hypot(cx, cy)
         big = 2.0 * curve * (math.sqrt(px * px + py * py) + w_big * span) - 2.0 * m
         fc = max(f, 0.0)
         if big <= 0.0:  # f is convex over the span: its tangent is below it

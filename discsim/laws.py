@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from discsim.errors import InvalidArgumentError
+from discsim.errors import InvalidArgumentError, UnitsError
 
 __all__ = ["LAW_SLOTS", "Laws"]
 
@@ -34,6 +34,9 @@ LAW_SLOTS = 8
 #: The default rest speed, as a bounce height: a disc that would bounce less high than this fraction of the
 #: smallest radius comes to rest (see :class:`Laws`).
 REST_HEIGHT = 1e-3
+#: A drag (1 / time) other than 0 lies within this range: the inverse of the times of impact the supported units
+#: keep (``discsim.model``), so ``gamma t`` stays a normal float (a subnormal one has lost its digits).
+DRAG_RANGE = (1e-100, 1e100)
 
 
 def _number(name: str, value) -> float:
@@ -92,6 +95,7 @@ class Laws:
             InvalidArgumentError: naming the argument and value: gravity not a pair of finite numbers, a
                 restitution outside [0, 1] (or a malformed dict), a negative or non-finite ``tc`` or
                 ``rest_speed``, a roughness outside [-1, 1], a negative or non-finite drag.
+            UnitsError: a drag other than 0 outside :data:`DRAG_RANGE`.
         """
         if gravity is None:
             g = (0.0, 0.0)
@@ -140,6 +144,13 @@ class Laws:
         if not (math.isfinite(gamma) and gamma >= 0.0):
             msg = f"drag must be a finite number >= 0 (1 / time), got {drag!r}"
             raise InvalidArgumentError(msg)
+        if gamma != 0.0 and not DRAG_RANGE[0] <= gamma <= DRAG_RANGE[1]:
+            lo, hi = DRAG_RANGE
+            msg = (
+                f"drag {drag!r} lies outside the range discsim supports ([{lo:g}, {hi:g}] or 0; "
+                "discsim.laws.DRAG_RANGE): express it in other units"
+            )
+            raise UnitsError(msg)
         return cls(g, e, tc, rest_speed, beta, gamma, pairs)
 
     @property

@@ -284,8 +284,9 @@ def damped_time_of_impact(
       never touch (and if it never comes down to ``sigma``, they never do);
     - steps: at ``t``, over the next ``S``, ``f(t + u) >= f + f' u - M u^2 / 2`` with ``M = 2 |a| e^(-gamma t)
       (|p| + W S) - 2 m``, where the relative velocity runs along the segment from ``p'(t)`` to the terminal
-      ``a / gamma`` (so ``|p'| <= W``, its larger end, and ``|p'|^2 >= m``, the segment's distance to 0, squared)
-      and ``|p''| <= |a - gamma p'(t)| e^(-gamma u)``. The bound's first root is no later than ``f``'s, so a step
+      ``a / gamma``, over the span only as far as ``p'(t) + (a - gamma p'(t)) tau(S)`` (so ``|p'| <= W``, that
+      piece's larger end, and ``|p'|^2 >= m``, the piece's distance to 0, squared) and ``|p''| <= |a - gamma
+      p'(t)| e^(-gamma u)``. The bound's first root is no later than ``f``'s, so a step
       to it never passes a contact; near a contact the steps shrink as Newton's do (quadratically), and the
       search ends when a step no longer moves ``t`` (contact, if approaching) or leaves the window (none).
 
@@ -310,7 +311,6 @@ def damped_time_of_impact(
         return INF
     end = _rising_root(start, q, wq, g, gamma, sigma)
     s2 = sigma * sigma
-    vtx, vty = ax / gamma, ay / gamma  # the terminal relative velocity
     t = 0.0
     reach = 0.0  # the span the last curvature bound covered
     for _ in range(_MAX_STEPS):
@@ -327,14 +327,21 @@ def damped_time_of_impact(
         span = min(end - t, max(2.0 * reach, (math.sqrt(max(f + s2, 0.0)) - sigma) / max(math.hypot(wx, wy), 1e-300)))
         if not span > 0.0:
             span = end - t
-        w_big = max(math.hypot(wx, wy), math.hypot(vtx, vty))
-        # The least |p'|^2 along the segment from p'(t) to the terminal velocity.
-        ex, ey = vtx - wx, vty - wy
+        # Over the span p' runs from p'(t) towards the terminal velocity, only as far as p'(t) + (a - gamma p'(t))
+        # tau(span) (not all the way: a tiny drag's terminal velocity would make the bound useless, and the steps
+        # tiny): the largest and the least |p'| over the span lie on that piece of the segment.
+        # p''(t) = a - gamma p'(t) = (a - gamma w) e^(-gamma t), written so: near the terminal velocity the
+        # difference is all roundoff, and would bound the curvature 1e16 times too high (a huge drag's steps).
+        decay = math.exp(-gamma * t)
+        cx, cy = (ax - gamma * dvx) * decay, (ay - gamma * dvy) * decay
+        reached = -math.expm1(-gamma * span) / gamma
+        ex, ey = cx * reached, cy * reached
+        w_big = max(math.hypot(wx, wy), math.hypot(wx + ex, wy + ey))
         ee = ex * ex + ey * ey
         k = 0.0 if ee == 0.0 else min(1.0, max(0.0, -(wx * ex + wy * ey) / ee))
         mx, my = wx + k * ex, wy + k * ey
         m = mx * mx + my * my
-        curve = math.hypot(ax - gamma * wx, ay - gamma * wy)
+        curve = math.hypot(cx, cy)
         big = 2.0 * curve * (math.sqrt(px * px + py * py) + w_big * span) - 2.0 * m
         fc = max(f, 0.0)
         if big <= 0.0:  # f is convex over the span: its tangent is below it

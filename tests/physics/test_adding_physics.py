@@ -173,7 +173,7 @@ def test_a_law_in_which_no_pair_ever_meets_gives_no_collision():
     assert len(log) == 300 and backend.counts()["collisions"] == 0 and backend.counts()["wall_hits"] == 300
 
 
-def _never(dx, dy, dvx, dvy, sigma, dax=0.0, day=0.0):
+def _never(dx, dy, dvx, dvy, sigma, dax=0.0, day=0.0, drag=0.0):
     """A pair time of impact for discs that pass through each other (the relative acceleration last, as every
     law's)."""
     return math.inf

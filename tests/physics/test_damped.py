@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 from discsim._numba import available
 from discsim.physics import damped, dynamics
 from discsim.physics.damped import damped_exit, damped_time_of_impact, spans, spans_many, time_of_span
+from discsim.physics.roots import accelerated_time_of_impact
 
 needs_numba = pytest.mark.skipif(not available(), reason="numba is not installed or hidden")
 coordinate = st.floats(0.5, 9.5)
@@ -133,6 +134,45 @@ def test_a_falling_disc_against_a_still_one_is_never_missed(dx, dy, wx, wy, ax, 
     grid = np.linspace(0.0, horizon, 100001)[:-1]
     assert (_separation(grid, d, w, acc, gamma) > sigma * (1 - 1e-12)).all()
     if t < math.inf:
+        assert _separation(np.array([t]), d, w, acc, gamma)[0] == pytest.approx(sigma, rel=1e-9)
+
+
+@pytest.mark.parametrize("gamma", [1e-12, 1e-9, 1e-6, 1e-3])
+def test_a_falling_disc_under_a_tiny_drag_meets_a_still_one_where_it_would_without(gamma):
+    # Dropped 3 above a still disc and 0.3 to the side (contact at 2): the drag moves the contact by about
+    # gamma t. (The curvature bound once took the terminal velocity g / gamma as the largest speed: steps of
+    # 1e-7 of the fall, and after _MAX_STEPS a "contact" 1.5 sigma apart.)
+    t = damped_time_of_impact(-0.3, -3.0, 0.0, 0.0, 0.0, 9.81, gamma, 2.0)
+    assert t == pytest.approx(accelerated_time_of_impact(-0.3, -3.0, 0.0, 0.0, 0.0, 9.81, 2.0), rel=10 * gamma + 1e-12)
+    assert _separation(np.array([t]), (-0.3, -3.0), (0.0, 0.0), (0.0, 9.81), gamma)[0] == pytest.approx(2.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("gamma", [1e6, 1e12, 1e20])
+def test_a_disc_sinking_at_its_terminal_velocity_under_a_huge_drag_meets_a_still_one_at_contact(gamma):
+    # From rest, 3 above and 0.3 to the side: the separation along gravity is -3 + g s(t), s = (t - tau) / gamma,
+    # and reaches -sqrt(4 - 0.09). (The curvature bound once took |a - gamma p'| at the terminal velocity, all
+    # roundoff, for the curvature: steps of 1e-4 of the way, and a "contact" 1.3 sigma apart after _MAX_STEPS.)
+    t = damped_time_of_impact(-0.3, -3.0, 0.0, 0.0, 0.0, 9.81, gamma, 2.0)
+    assert t == pytest.approx(gamma * (3.0 - math.sqrt(3.91)) / 9.81 + 1.0 / gamma, rel=1e-9)
+    assert _separation(np.array([t]), (-0.3, -3.0), (0.0, 0.0), (0.0, 9.81), gamma)[0] == pytest.approx(2.0, rel=1e-12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), speed, speed, st.floats(-3.0, 3.0, allow_subnormal=False),
+    st.floats(-10.0, -0.1), st.floats(-12.0, 12.0), st.floats(0.3, 2.0),
+)  # fmt: skip
+def test_a_falling_disc_against_a_still_one_is_met_at_contact_under_drags_from_tiny_to_huge(
+    dx, dy, wx, wy, ax, ay, log_gamma, sigma
+):
+    assume(math.hypot(dx, dy) > sigma * 1.001)
+    gamma = 10.0**log_gamma
+    d, w, acc = (dx, dy), (wx, wy), (ax, ay)
+    t = damped_time_of_impact(dx, dy, wx, wy, ax, ay, gamma, sigma)
+    horizon = t if t < math.inf else min(40.0 / gamma + 20.0, 300.0)
+    grid = np.linspace(0.0, horizon, 100001)[:-1]
+    assert (_separation(grid, d, w, acc, gamma) > sigma * (1 - 1e-12)).all()
+    if t < math.inf:  # a contact, not a time the search gave up at
         assert _separation(np.array([t]), d, w, acc, gamma)[0] == pytest.approx(sigma, rel=1e-9)
 
 

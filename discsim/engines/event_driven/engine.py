@@ -88,10 +88,10 @@ class EventDriven(Turning, RunStops, Engine):
             (energy conserving); between, energy lost. The impulse at the contact point turns the discs
             (``discs.spins``, ``discs.inertia``; :attr:`spins`, :attr:`angles`, :attr:`spin_events`); walls and
             segments are as rough as the discs (``docs/laws.md``).
-        drag: a linear drag ``gamma`` >= 0 (1 / time) on every disc of finite mass, the force ``-m gamma v``:
-            exact exponential flight between events, towards the terminal velocity ``gravity / gamma``
-            (``docs/laws.md``); 0: none. Its energy loss is not in :attr:`dissipated` (which counts the
-            collisions'): it is the rest of the drop in :meth:`energy`.
+        drag: a linear drag ``gamma`` (1 / time; 0, or within :data:`discsim.laws.DRAG_RANGE`) on every disc of
+            finite mass, the force ``-m gamma v``: exact exponential flight between events, towards the terminal
+            velocity ``gravity / gamma`` (``docs/laws.md``); 0: none. Its energy loss is in :attr:`dissipated`
+            with the collisions', so ``energy() + dissipated`` stays constant.
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
@@ -371,8 +371,9 @@ class EventDriven(Turning, RunStops, Engine):
 
     @property
     def dissipated(self) -> float:
-        """Kinetic energy lost since the start: by collisions with restitution below 1, and by discs coming to
-        rest under gravity (0 for elastic discs)."""
+        """Kinetic energy lost since the start: by collisions with restitution below 1, by rough collisions, by
+        discs coming to rest under gravity, and to the drag (up to ``time``, flights under way included); 0 for
+        elastic, smooth discs without drag."""
         return self._backend.dissipated
 
     @property

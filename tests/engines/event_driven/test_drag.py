@@ -2,12 +2,13 @@
 energy bookkeeping, both backends bit for bit, trajectories, checkpoints, bad input."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
 import discsim as ds
-from discsim.errors import InvalidArgumentError
+from discsim.errors import InvalidArgumentError, UnitsError
 from discsim.physics.damped import spans_many
 
 G = 9.81
@@ -52,6 +53,17 @@ def test_two_discs_meet_at_free_flights_contact_in_the_transformed_time(every_ba
     event = sim.step()
     assert event.kind == "collision"
     assert event.time == pytest.approx(-math.log1p(-gamma * 2.0) / gamma, rel=1e-13)
+
+
+@pytest.mark.parametrize("gamma", [1e-12, 1e-9])
+def test_a_ball_dropped_on_an_obstacle_under_a_tiny_drag_hits_it_at_contact_and_bounces(every_backend, gamma):
+    # Once hit "at" 1.5 its contact distance, 1e-4 into the fall, and came to rest there in mid-air.
+    discs = ds.Discs([[5.0, 3.0], [5.3, 6.0]], [[0.0, 0.0], [0.0, 0.0]], radii=1.0, masses=[np.inf, 1.0])
+    sim = ds.EventDriven(discs, BOX, gravity=(0.0, -G), drag=gamma, restitution=0.7)
+    event = sim.step()
+    assert event.kind == "collision" and event.time == pytest.approx(0.4566036043583582, rel=1e-9)
+    assert np.hypot(*(sim.positions[1] - sim.positions[0])) == pytest.approx(2.0, rel=1e-12)
+    assert not sim.resting.any() and sim.velocities[1, 1] > 0.0
 
 
 # --- the oracle -------------------------------------------------------------------------------------------------
@@ -189,6 +201,19 @@ def test_a_run_under_drag_continues_from_a_checkpoint_bit_for_bit(every_backend,
     assert resumed.dissipated == pytest.approx(whole.dissipated, rel=1e-12)
 
 
+def test_replays_of_free_flight_refuse_a_run_under_drag(tmp_path):
+    # They once replayed it as free flight: frames() put the disc at x = -8.3, outside the box.
+    sim = ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=0.5).run(until=5.0)
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.frames(sim, [2.5])
+    path = tmp_path / "events.dse"
+    ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=0.5, record=False).run(until=5.0, record_to=path)
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.trajectory_from_events(path, [2.5])
+    with pytest.raises(InvalidArgumentError, match="drag 0.5"):
+        ds.read_events(path).trajectory([2.5])
+
+
 def test_drag_zero_is_todays_physics():
     discs, box = ds.random_gas(30, 0.3, seed=1)
     plain = ds.EventDriven(discs, box, backend="python").run(events=300)
@@ -209,3 +234,20 @@ def test_a_log_streamed_under_drag_says_so_and_its_replays_refuse_it(tmp_path):
         ds.frames(path, [1.0])
     with pytest.raises(InvalidArgumentError, match="drag 0.5"):
         ds.trajectory_from_events(path, [1.0])
+
+
+@pytest.mark.parametrize("drag", [5e-324, 1e-315, 1e-101, 1e101])
+def test_a_drag_outside_the_supported_units_is_refused_naming_it(drag):
+    # A subnormal drag once flew a disc through the wall: gamma t loses its digits, so tau(0.875) came out 1.
+    with pytest.raises(UnitsError, match=re.escape(f"drag {drag!r}")):
+        ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=drag)
+
+
+@pytest.mark.parametrize("drag", [1e-100, 1e100])
+def test_the_ends_of_the_drags_units_fly_as_no_drag_and_as_an_instant_stop(drag):
+    sim = ds.EventDriven(ball(2.0, 5.0, 8.0), BOX, drag=drag)
+    sim.run(until=1.5)
+    if drag < 1.0:
+        assert times(sim).tolist() == [0.875] and sim.positions[0].tolist() == [4.0, 5.0]
+    else:
+        assert times(sim).tolist() == [] and sim.positions[0] == pytest.approx([2.0 + 8.0 / drag, 5.0], abs=1e-15)

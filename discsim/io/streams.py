@@ -103,6 +103,7 @@ class StreamedEvents:
         ids: ``(N,)`` the ids of ``discs`` (the names the records give them), or None: their indices.
         gravity: the run's ``(gx, gy)`` if it ran under gravity (:meth:`trajectory` follows its parabolas), else None.
         resting: ``(N,)`` bool, the ``discs`` at rest at ``start_time`` (under gravity), or None: none.
+        drag: the run's drag ``gamma`` (0: none; :meth:`trajectory` follows its exponential flights).
     """
 
     events: np.ndarray
@@ -114,6 +115,7 @@ class StreamedEvents:
     ids: np.ndarray | None = None
     gravity: tuple | None = None
     resting: np.ndarray | None = None
+    drag: float = 0.0
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -137,6 +139,7 @@ class StreamedEvents:
             ids=self.ids,
             gravity=self.gravity,
             still=self.resting,
+            drag=self.drag,
         )
 
 
@@ -189,6 +192,7 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
         ids,
         None if gravity is None else tuple(gravity),
         _resting(path, stream.arrays, len(discs)),
+        float(stream.meta.get("drag", 0.0)),
     )
 
 

@@ -71,7 +71,9 @@ def spans(dt: float, gamma: float) -> tuple[float, float, float]:
         s = dt * dt * c
     else:
         s = (dt - tau) / gamma
-    return tau, s, 1.0 + em
+    # e^(-x): from expm1 while it keeps its digits; past x = 0.5 from exp itself (1 + expm1 is exactly 0 once
+    # e^(-x) drops below half an ulp of 1, at x = 37, and a decayed velocity would read exactly 0).
+    return tau, s, (1.0 + em if x < _SERIES else math.exp(-x))
 
 
 #: ``_INVERSE[k] = 1 / (k + 2)!``, the series' coefficients in :func:`spans`.
@@ -101,7 +103,7 @@ def spans_many(dt: np.ndarray, gamma: float) -> tuple[np.ndarray, np.ndarray, np
         c = _INVERSE[k] - xs * c
     with np.errstate(invalid="ignore", over="ignore"):
         s = np.where(small, dt * dt * c, (dt - tau) / gamma)
-    return tau, s, 1.0 + em
+    return tau, s, np.where(x < _SERIES, 1.0 + em, np.exp(-x))
 
 
 def time_of_span(tau: float, gamma: float) -> float:

@@ -279,6 +279,7 @@ def test_backends_script_writes_both_backends_side_by_side(tmp_path):
     }
 
 
+@pytest.mark.slow  # 3 s
 @pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
 def test_scale_script_writes_a_row_per_gas_and_size_and_its_plot(tmp_path):
     done = run_quick("scale.py", tmp_path)
@@ -294,6 +295,7 @@ def test_scale_script_writes_a_row_per_gas_and_size_and_its_plot(tmp_path):
     assert (tmp_path / "scale.png").stat().st_size > 0
 
 
+@pytest.mark.slow  # 2 s
 @pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
 def test_memory_order_script_writes_each_order(tmp_path):
     done = run_quick("memory_order.py", tmp_path)

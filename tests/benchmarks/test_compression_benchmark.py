@@ -5,9 +5,11 @@ import os
 import subprocess
 import sys
 
+import pytest
 from paths import BENCHMARKS
 
 
+@pytest.mark.slow  # 6 s
 def test_compression_benchmark_quick(tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     done = subprocess.run(

@@ -24,6 +24,7 @@ def equation_of_state(tmp_path_factory):
     return first, second, results, csv_first
 
 
+@pytest.mark.slow  # the module's fixture runs the script twice: 5 s
 def test_equation_of_state_quick_writes_its_csv_and_figure(equation_of_state):
     first, _, results, _ = equation_of_state
     assert first.returncode == 0, first.stderr
@@ -48,6 +49,7 @@ def test_equation_of_state_quick_writes_its_csv_and_figure(equation_of_state):
     assert rows[0]["check_z"] == ""
 
 
+@pytest.mark.slow
 def test_equation_of_state_rerun_reads_the_cache(equation_of_state):
     first, second, results, csv_first = equation_of_state
     assert first.returncode == 0, first.stderr

@@ -55,6 +55,7 @@ def test_ctrl_c_leaves_a_consistent_engine_that_goes_on_bit_for_bit(name):
     assert sim.counts == reference.counts
 
 
+@pytest.mark.slow  # 8 s: a run of a second or more, interrupted
 def test_a_program_handler_of_sigint_still_gets_the_signal(monkeypatch):
     """Deferred to the end of the event, handed to the handler the program installed, and the run goes on."""
     got = []

@@ -17,9 +17,12 @@ import numpy as np
 __all__ = [
     "ADD",
     "COLLISION",
+    "ENTER",
     "EVENT_DTYPE",
     "KIND_NAMES",
+    "LEAVE",
     "REMOVE",
+    "SENSED",
     "SET",
     "SPIN_DTYPE",
     "WALL",
@@ -38,8 +41,11 @@ class EventKind(IntEnum):
     hit), ``SET`` (a disc changed by the user: ``set_velocities``, ``apply_impulse``,
     ``set_positions``; or, under gravity, a disc at rest that falls again because what held it up went: where it
     is, velocity zero; ``j`` is -1), ``ADD`` and ``REMOVE`` (a disc added by ``add_discs`` or removed by
-    ``remove_discs``; ``j`` is -1; see :class:`EventLog` for their fields) only; ``CROSSING`` (a disc
-    enters another cell) and ``SEGMENT`` (a segment hit, logged as ``WALL``) live in the engines' queues.
+    ``remove_discs``; ``j`` is -1; see :class:`EventLog` for their fields), ``ENTER`` and ``LEAVE`` (a disc's
+    centre enters or leaves a sensor, :class:`discsim.Sensor`: ``j`` is the sensor's index, the ``i`` fields the
+    disc's centre and velocity then; the motion does not change) only; ``CROSSING`` (a disc enters another
+    cell), ``SEGMENT`` (a segment hit, logged as ``WALL``) and ``SENSOR`` (a centre changes sides of a sensor,
+    logged as ``ENTER`` or ``LEAVE``, or not at all beyond a trip wire's ends) live in the engines' queues.
     """
 
     COLLISION = 0
@@ -49,6 +55,9 @@ class EventKind(IntEnum):
     SET = 4
     ADD = 5
     REMOVE = 6
+    SENSOR = 7
+    ENTER = 8
+    LEAVE = 9
 
 
 COLLISION = int(EventKind.COLLISION)
@@ -56,7 +65,13 @@ WALL = int(EventKind.WALL)
 SET = int(EventKind.SET)
 ADD = int(EventKind.ADD)
 REMOVE = int(EventKind.REMOVE)
-KIND_NAMES = {COLLISION: "collision", WALL: "wall", SET: "set", ADD: "add", REMOVE: "remove"}
+ENTER = int(EventKind.ENTER)
+LEAVE = int(EventKind.LEAVE)
+KIND_NAMES = {
+    COLLISION: "collision", WALL: "wall", SET: "set", ADD: "add", REMOVE: "remove", ENTER: "enter", LEAVE: "leave"
+}  # fmt: skip
+#: The kinds of a sensor's records: ``j`` is a sensor, not a disc, and the motion does not change.
+SENSED = (ENTER, LEAVE)
 
 
 class Event(NamedTuple):
@@ -64,9 +79,9 @@ class Event(NamedTuple):
 
     Attributes:
         time: when it happened.
-        kind: ``"collision"`` (disc-disc), ``"wall"``, or a change made by the user: ``"set"``, ``"add"``,
-            ``"remove"``.
-        i: the first disc. j: the second disc, or -1 for a wall hit.
+        kind: ``"collision"`` (disc-disc), ``"wall"``, ``"enter"`` or ``"leave"`` (a sensor), or a change made by
+            the user: ``"set"``, ``"add"``, ``"remove"``.
+        i: the first disc. j: the second disc, -1 for a wall hit, or the sensor's index.
     """
 
     time: float
@@ -227,7 +242,7 @@ class EventLog:
         rows = np.array(rows)
         rows["i"] = ids[rows["i"]]
         j = rows["j"]
-        pair = j >= 0
+        pair = (j >= 0) & (rows["kind"] != ENTER) & (rows["kind"] != LEAVE)  # a sensor's j is the sensor's index
         rows["j"] = np.where(pair, ids[np.where(pair, j, 0)], j)
         return rows
 

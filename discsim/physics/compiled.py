@@ -15,7 +15,7 @@ from discsim import model
 from discsim._compiled import compile_from_source, interpret, jit
 from discsim._numba import numba
 from discsim.physics import damped, dynamics, laws, roots
-from discsim.physics.sources import boundaries, pairs
+from discsim.physics.sources import boundaries, pairs, sensors
 
 __all__ = [
     "DYNAMICS",
@@ -37,6 +37,7 @@ __all__ = [
     "reflect_off_segment",
     "rough_impulse",
     "segment_time_of_impact",
+    "sensor_predict",
     "wall_time",
 ]
 
@@ -60,6 +61,7 @@ _SOURCES = (
     boundaries.predict_y,
     boundaries.cross,
     boundaries.wall_time,
+    *sensors.PARTS,
 )
 #: The names the compiled loops import, and the source of each.
 _NAMES = {
@@ -73,6 +75,7 @@ _NAMES = {
     "predict_y": boundaries.predict_y,
     "cross": boundaries.cross,
     "wall_time": boundaries.wall_time,
+    "sensor_predict": sensors.predict,
 }
 
 
@@ -123,3 +126,4 @@ predict_x = _parts["predict_x"]
 predict_y = _parts["predict_y"]
 cross = _parts["cross"]
 wall_time = _parts["wall_time"]
+sensor_predict = _parts["sensor_predict"]

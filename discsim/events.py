@@ -18,6 +18,7 @@ __all__ = [
     "ADD",
     "COLLISION",
     "ENTER",
+    "Crossing",
     "EVENT_DTYPE",
     "KIND_NAMES",
     "LEAVE",
@@ -88,6 +89,22 @@ class Event(NamedTuple):
     kind: str
     i: int
     j: int
+
+
+class Crossing(NamedTuple):
+    """A disc's centre entering or leaving a sensor, as a callback of ``sim.on("enter" | "leave", fn)`` receives it.
+
+    Attributes:
+        time: when. kind: ``"enter"`` or ``"leave"``. i: the disc (its index now). sensor: the sensor's index
+            (``sim.sensors[sensor]``). position, velocity: ``(2,)`` the disc's centre and velocity then.
+    """
+
+    time: float
+    kind: str
+    i: int
+    sensor: int
+    position: np.ndarray
+    velocity: np.ndarray
 
 
 def event_from_record(record) -> Event:

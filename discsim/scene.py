@@ -14,6 +14,7 @@ import numpy as np
 from discsim.cells import neighbour_pair_chunks
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, RESOLUTION, Box, Discs, Segment, normalize_pass_through
+from discsim.sensors import check_sensors
 
 __all__ = ["Scene", "check_added", "check_fits", "check_scene", "filter_table"]
 
@@ -219,11 +220,13 @@ class Scene:
         box: the :class:`~discsim.model.Box`.
         segments: fixed :class:`~discsim.model.Segment` walls (walled boxes only).
         pass_through: pairs of group labels whose discs pass through each other.
+        sensors: :class:`~discsim.sensors.Sensor` regions and trip wires (none by default); in a periodic box
+            a circle or rectangle must lie inside the box.
         check: False for the scene of discs an engine already holds (``add_discs`` checks the new ones with
             :func:`check_added`): ``segments`` and ``pass_through`` as a scene holds them, no check at all.
 
     Attributes:
-        discs, box: as given. segments (tuple[Segment, ...]): as given.
+        discs, box: as given. segments (tuple[Segment, ...]), sensors (tuple[Sensor, ...]): as given.
         pass_through (frozenset[tuple[int, int]]): sorted group pairs.
         group ((N,) int64): each disc's group as an index into ``blocked``.
         blocked ((G, G) bool): True where two groups pass through each other.
@@ -242,9 +245,10 @@ class Scene:
         [True]
     """
 
-    def __init__(self, discs: Discs, box: Box, segments=(), pass_through=(), *, check: bool = True):
+    def __init__(self, discs: Discs, box: Box, segments=(), pass_through=(), *, sensors=(), check: bool = True):
         if not check:  # the discs, segments and filter of an engine's own scene, validated when they came in
             self.segments, self.pass_through = tuple(segments), frozenset(pass_through)
+            self.sensors = tuple(sensors)
             self.discs, self.box = discs, box
             self.group, self.blocked = filter_table(discs.groups, self.pass_through)
             return
@@ -255,6 +259,16 @@ class Scene:
             msg = f"box must be a discsim.Box, got {type(box).__name__} {_short(box)}"
             raise WrongTypeError(msg)
         self.segments, self.pass_through = check_scene(discs, box, segments, pass_through)
+        self.sensors = check_sensors(sensors)
+        if box.periodic:
+            for k, sensor in enumerate(self.sensors):
+                x0, y0, x1, y1 = sensor.bounds()
+                if sensor.shape != "line" and not (0.0 <= x0 and x1 <= box.width and 0.0 <= y0 and y1 <= box.height):
+                    msg = (
+                        f"sensors[{k}] {sensor!r} must lie inside the periodic box {box.width:g} x {box.height:g} "
+                        "(a region across its edge would be entered without a crossing)"
+                    )
+                    raise InvalidArgumentError(msg)
         self.discs = discs
         self.box = box
         self.group, self.blocked = filter_table(discs.groups, self.pass_through)

@@ -27,7 +27,7 @@ import numpy as np
 from discsim.errors import InvalidArgumentError
 from discsim.model import _readonly, _real_array
 
-__all__ = ["CIRCLE", "LINE", "RECTANGLE", "Sensor", "check_sensors", "sensor_rows"]
+__all__ = ["CIRCLE", "LINE", "RECTANGLE", "Sensor", "check_sensors", "inside_table", "sensor_rows"]
 
 #: The shape codes of :func:`sensor_rows` (what the compiled loop reads).
 CIRCLE, RECTANGLE, LINE = 1, 2, 3
@@ -187,3 +187,12 @@ def sensor_rows(sensors) -> np.ndarray:
         rows[k, :4] = sensor.params
         rows[k, 4] = sensor.code
     return rows
+
+
+def inside_table(sensors, positions) -> np.ndarray:
+    """``(N, S)`` int64: 1 where each of ``positions`` ``(N, 2)`` is inside each sensor (:meth:`Sensor.contains`)."""
+    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+    table = np.zeros((len(positions), len(sensors)), dtype=np.int64)
+    for k, sensor in enumerate(sensors):
+        table[:, k] = sensor.contains(positions) if len(positions) else 0
+    return table

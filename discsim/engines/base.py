@@ -196,6 +196,8 @@ class Engine(DiscEditing, EventRecord, SpatialQueries, ABC):
         self.discs = scene.discs
         self.box = scene.box
         self.segments = scene.segments
+        #: The :class:`~discsim.sensors.Sensor` regions and trip wires (a tuple; empty without).
+        self.sensors = scene.sensors
         self.pass_through = scene.pass_through
         if not isinstance(record, (bool, np.bool_)):  # bool("False") would be True
             msg = f"record must be True or False, got {record!r}"

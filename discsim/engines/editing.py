@@ -56,7 +56,7 @@ class DiscEditing:
         """Refuse ``what`` (an edit, or a callback) before anything changes, where the engine cannot take it."""
 
     #: Event kinds a callback can follow with :meth:`on`.
-    CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment")
+    CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment", "enter", "leave")
 
     def set_velocities(self, indices, velocities):
         """Give discs ``indices`` new ``velocities`` ``(K, 2)`` (or one ``(2,)`` for all) at ``time``.
@@ -171,7 +171,7 @@ class DiscEditing:
         everyone = Discs(*(np.concatenate([getattr(now, name), getattr(discs, name)]) for name in _DISC_FIELDS))
         scene = self.scene
         check_added(everyone, self.box, n, scene.segments, scene.pass_through)
-        new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, check=False)
+        new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, sensors=scene.sensors, check=False)
         context = self.run_context
         ids = np.arange(context.next_id, context.next_id + k, dtype=np.int64)
         ids_after, origin = np.concatenate([self.ids, ids]), self._log_origin()
@@ -217,7 +217,7 @@ class DiscEditing:
         gone_positions, gone_velocities = now.positions[np.sort(idx)], now.velocities[np.sort(idx)]
         rest = Discs(*(getattr(now, name)[keep] for name in _DISC_FIELDS))
         scene = self.scene
-        new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, check=False)
+        new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, sensors=scene.sensors, check=False)
         gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()
         resting = _resting_ids(self)
         self._restructure(keep, None, new_scene)
@@ -258,10 +258,13 @@ class DiscEditing:
         return self.run_context.next_id
 
     def on(self, kind: str, fn, *, changes: bool = True):
-        """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"`` or ``"segment"``).
+        """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"``, ``"segment"``, or a
+        sensor's ``"enter"`` and ``"leave"``).
 
         ``contact`` is a :class:`~discsim.analysis.contacts.Contact` (time, kind, discs, contact point,
-        unit normal, impulse, normal speed). Returns ``self``.
+        unit normal, impulse, normal speed), or for a sensor a :class:`~discsim.events.Crossing` (time, kind,
+        disc, sensor, the disc's centre and velocity). A pocket is a sensor whose callback removes the disc:
+        ``sim.on("enter", lambda sim, c: sim.remove_discs([c.i]))``. Returns ``self``.
 
         - ``changes=True`` (the default): the callback may change the simulation (``set_velocities``,
           ``apply_impulse``, ``set_positions``, ``add_discs``, ``remove_discs``) and the run goes on exactly

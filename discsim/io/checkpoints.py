@@ -40,6 +40,7 @@ from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
 from discsim.model import Box, Discs, Segment, image_steps
 from discsim.scene import Scene
+from discsim.sensors import Sensor
 from discsim.trajectory import reconstruct
 
 __all__ = ["checkpoint_info", "load", "resume", "save", "write_checkpoint"]
@@ -77,6 +78,7 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         "scene": {
             "segments": [[*s.p0.tolist(), *s.p1.tolist()] for s in scene.segments],
             "pass_through": sorted(scene.pass_through),
+            "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in scene.sensors],
         },
         "settings": {**engine._settings(), "record": record},
         "state_version": engine.STATE.VERSION,
@@ -235,10 +237,11 @@ def load(path, *, backend: str | None = None):
             settings = {**settings, "backend": backend or "auto"}
         segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
         pass_through = [tuple(pair) for pair in scene_meta.get("pass_through", [])]
+        sensors = [Sensor(int(row[0]), row[1:]) for row in scene_meta.get("sensors", [])]
         if changed:
-            scene = Scene(discs, box, tuple(segments), frozenset(pass_through), check=False)
+            scene = Scene(discs, box, tuple(segments), frozenset(pass_through), sensors=sensors, check=False)
         else:
-            scene = Scene(discs, box, segments, pass_through)
+            scene = Scene(discs, box, segments, pass_through, sensors=sensors)
         sim = engine._restore(scene, settings, state, events, float(meta["start_time"]))
         if "spin_events" in arrays:
             sim._restore_spin_events(arrays["spin_events"])

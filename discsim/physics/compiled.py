@@ -37,6 +37,8 @@ __all__ = [
     "reflect_off_segment",
     "rough_impulse",
     "segment_time_of_impact",
+    "sensor_contains",
+    "sensor_on_wire",
     "sensor_predict",
     "wall_time",
 ]
@@ -76,6 +78,8 @@ _NAMES = {
     "cross": boundaries.cross,
     "wall_time": boundaries.wall_time,
     "sensor_predict": sensors.predict,
+    "sensor_contains": sensors.contains,
+    "sensor_on_wire": sensors.on_wire,
 }
 
 
@@ -127,3 +131,5 @@ predict_y = _parts["predict_y"]
 cross = _parts["cross"]
 wall_time = _parts["wall_time"]
 sensor_predict = _parts["sensor_predict"]
+sensor_contains = _parts["sensor_contains"]
+sensor_on_wire = _parts["sensor_on_wire"]

@@ -1,4 +1,5 @@
-"""``sim.on(kind, fn)``: callbacks after each collision, wall hit or segment hit, as an observer of the run.
+"""``sim.on(kind, fn)``: callbacks after each collision, wall hit, segment hit or sensor event, as an observer of
+the run.
 
 While callbacks are registered, ``run()`` adds an :class:`EventHandlers` observer that asks the driver for
 chunks of one unit of work (one physical event for ``EventDriven``, one frame for ``FixedStep``), so each
@@ -19,7 +20,7 @@ import numpy as np
 from discsim.analysis.contacts import contact_of_record, contacts_of
 from discsim.engines.context import LookOnly
 from discsim.errors import InvalidArgumentError
-from discsim.events import ADD, COLLISION, REMOVE, WALL
+from discsim.events import ADD, COLLISION, KIND_NAMES, REMOVE, SENSED, WALL, Crossing
 from discsim.run.observers import Observer
 
 __all__ = ["EventHandlers"]
@@ -66,8 +67,50 @@ class EventHandlers(Observer):
             return
         events = np.array(events)
         events["i"] = index[events["i"]]
+        sensed = np.isin(events["kind"], SENSED)  # j: a sensor's index, not a disc
+        if sensed.any():
+            self._with_crossings(engine, events, sensed)
+            return
         pair = events["j"] >= 0
         events["j"][pair] = index[events["j"][pair]]
+        self._contacts(engine, events)
+
+    def _with_crossings(self, engine, events, sensed) -> None:
+        """A chunk with sensor events: the contacts between them, and each crossing in its turn."""
+        cut = np.flatnonzero(sensed)
+        start = 0
+        for k in [*cut.tolist(), len(events)]:
+            if k > start:
+                piece = np.array(events[start:k])
+                pair = piece["j"] >= 0
+                piece["j"][pair] = self._index[piece["j"][pair]]
+                self._contacts(engine, piece)
+            if k < len(events):
+                self._crossing(engine, events[k])
+            start = k + 1
+
+    def _crossing(self, engine, rec) -> None:
+        """Call the callbacks of one sensor event (``rec["i"]`` already an index)."""
+        kind = KIND_NAMES[int(rec["kind"])]
+        fns = self.handlers.get(kind, ())
+        if not fns:
+            return
+        crossing = Crossing(
+            float(rec["time"]), kind, int(rec["i"]), int(rec["j"]),
+            np.array([rec["xi"], rec["yi"]]), np.array([rec["vxi"], rec["vyi"]]),
+        )  # fmt: skip
+        for fn in fns:
+            if isinstance(fn, LookOnly):
+                self._look_only(engine, fn, kind, crossing)
+            else:
+                fn(engine, crossing)
+        if engine.run_context.structure != self._structure:  # a callback added or removed discs
+            self._look(engine)
+
+    def _contacts(self, engine, events) -> None:
+        """Call the callbacks of the collisions and wall hits of ``events`` (discs already indices)."""
+        if not len(events):
+            return
         found = contacts_of(events, self._velocities, self._masses, self._radii, engine.box, engine.segments)
         rows = np.concatenate([events["i"], events["j"][events["j"] >= 0]])
         after = np.concatenate(

@@ -13,6 +13,7 @@ import numpy as np
 from discsim.cells import CellGrid
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.scene import Scene
+from discsim.sensors import inside_table
 
 __all__ = ["RENUMBER_MIN", "TILE", "cell_order", "fresh_state", "internal_order"]
 
@@ -99,4 +100,5 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
         last_collision=np.full(n, -math.inf),
         spins=np.array(discs.spins),
         angles=np.zeros(n),
+        sensed=inside_table(scene.sensors, discs.positions),
     )

@@ -19,9 +19,9 @@ __all__ = ["EventDrivenState"]
 
 @dataclass(eq=False)
 class EventDrivenState(EngineState):
-    """Everything an event-driven run needs to continue bit for bit (version 3: version 1 plus the laws' fields
-    (version 2) and the discs' turning (version 3); an older state reads the fields it lacks as their defaults:
-    no disc at rest, no collision recorded, spins and angles zero).
+    """Everything an event-driven run needs to continue bit for bit (version 4: version 1 plus the laws' fields
+    (version 2), the discs' turning (version 3) and the sensors' (version 4); an older state reads the fields it
+    lacks as their defaults: no disc at rest, no collision recorded, spins and angles zero, no sensor).
 
     Per-disc arrays are indexed in the caller's numbering (as ``discs``); disc
     indices inside arrays (partners, cell members, queue owners) too. Times in
@@ -62,12 +62,15 @@ class EventDrivenState(EngineState):
             between its collisions, changed only by those of rough discs (``roughness`` above -1).
         angles ``(N,)``: each disc's angle at ``time`` (radians, counter-clockwise, 0 at the start): the
             orientation a viewer's mark shows; no law reads it.
+        sensed ``(N, S)`` int64: 1 where disc ``i``'s centre is inside sensor ``k`` (:class:`discsim.Sensor`; a
+            line's left side) as the run knows it (a disc on the edge just after crossing it counts as crossed);
+            ``(N, 0)`` without sensors, or unknown: the backend then takes it from where the discs are.
 
     Scalars of the laws: dissipated (kinetic energy lost in collisions and by discs coming to rest),
-    rests (discs put to rest).
+    rests (discs put to rest). Of the sensors: sensor_events (enter and leave events).
     """
 
-    VERSION = 3
+    VERSION = 4
 
     time: float
     epoch: float
@@ -109,6 +112,8 @@ class EventDrivenState(EngineState):
     rests: int = 0
     spins: np.ndarray = None  # type: ignore[assignment]  # None: zeros (filled in by __post_init__)
     angles: np.ndarray = None  # type: ignore[assignment]  # None: zeros
+    sensed: np.ndarray = None  # type: ignore[assignment]  # None: (N, 0), taken from the positions when loaded
+    sensor_events: int = 0
 
     def __post_init__(self) -> None:
         n = len(self.order)
@@ -120,11 +125,13 @@ class EventDrivenState(EngineState):
             self.spins = np.zeros(n)
         if self.angles is None:
             self.angles = np.zeros(n)
+        if self.sensed is None:
+            self.sensed = np.zeros((n, 0), dtype=np.int64)
 
     @classmethod
     def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int):
         """As :meth:`EngineState.from_arrays`; a version-1 state (before the laws) gets their defaults, a version-1
-        or 2 state (before spins) spins and angles zero."""
+        or 2 state (before spins) spins and angles zero, a version 1 to 3 state no sensor."""
         n = len(arrays.get("order", ()))
         if version == 1:
             arrays = {**arrays, "resting": np.zeros(n, dtype=np.int64), "last_collision": np.full(n, -np.inf)}
@@ -132,6 +139,10 @@ class EventDrivenState(EngineState):
             version = 2
         if version == 2:
             arrays = {**arrays, "spins": np.zeros(n), "angles": np.zeros(n)}
+            version = 3
+        if version == 3:
+            arrays = {**arrays, "sensed": np.zeros((n, 0), dtype=np.int64)}
+            scalars = {**scalars, "sensor_events": 0}
             version = cls.VERSION
         return super().from_arrays(scalars, arrays, version)
 
@@ -206,8 +217,14 @@ class EventDrivenState(EngineState):
             fail("queue_owner", "at most one pending event per disc")
         if ((self.queue_owner < 0) | (self.queue_owner >= n)).any():
             fail("queue_owner", f"disc indices must lie in [0, {n})")
-        if ((self.queue_kind < 0) | (self.queue_kind > 3)).any():
-            fail("queue_kind", "kinds are 0 (collision), 1 (wall), 2 (crossing) and 3 (segment)")
+        if ((self.queue_kind < 0) | ((self.queue_kind > 3) & (self.queue_kind != 7))).any():
+            fail("queue_kind", "kinds are 0 (collision), 1 (wall), 2 (crossing), 3 (segment) and 7 (sensor)")
+        sensed = self.sensed
+        if not isinstance(sensed, np.ndarray) or sensed.ndim != 2 or len(sensed) != n or sensed.dtype.kind != "i":
+            got = f"{sensed.dtype} {sensed.shape}" if isinstance(sensed, np.ndarray) else type(sensed).__name__
+            fail("sensed", f"expected an integer array of shape ({n}, S), got {got}")
+        if ((sensed != 0) & (sensed != 1)).any():
+            fail("sensed", "expected 0 or 1")
         partners = self.queue_other[self.queue_kind == 0]
         if ((partners < 0) | (partners >= n)).any() or ((self.kept_partner < -1) | (self.kept_partner >= n)).any():
             fail("queue_other", f"collision partners must lie in [0, {n})")

@@ -37,8 +37,10 @@ from discsim.physics.roots import accelerated_time_of_impact, linear_contact
 __all__ = [
     "accelerated_leave",
     "circle_time",
+    "contains",
     "fall_to_zero",
     "line_time",
+    "on_wire",
     "predict",
     "rectangle_time",
     "rise_time",
@@ -95,10 +97,11 @@ def line_time(
 
 
 def _enter_slab(x: float, v: float, a: float, drag: float, lo: float, hi: float) -> float:
-    """Time until a coordinate enters the slab ``lo <= x <= hi`` (0 if in it now), or ``inf``."""
-    if x < lo:
+    """Time until a coordinate enters the slab ``lo < x < hi`` (0 if in it now, or on its edge moving in), or
+    ``inf``; on an edge moving out (just left), the time it comes back."""
+    if x <= lo:
         return fall_to_zero(lo - x, -v, -a, drag)
-    if x > hi:
+    if x >= hi:
         return fall_to_zero(x - hi, v, a, drag)
     return 0.0
 
@@ -267,6 +270,23 @@ def circle_time(
     return accelerated_time_of_impact(dx, dy, vx, vy, ax, ay, r)
 
 
+def contains(shape: float, a0: float, a1: float, a2: float, a3: float, x: float, y: float) -> bool:
+    """Whether ``(x, y)`` is inside a sensor: :meth:`discsim.sensors.Sensor.contains`, on floats."""
+    if shape == CIRCLE:
+        dx, dy = x - a0, y - a1
+        return dx * dx + dy * dy < a2 * a2
+    if shape == RECTANGLE:
+        return a0 < x < a2 and a1 < y < a3
+    return (a2 - a0) * (y - a1) - (a3 - a1) * (x - a0) > 0.0
+
+
+def on_wire(a0: float, a1: float, a2: float, a3: float, x: float, y: float) -> bool:
+    """Whether a centre ``(x, y)`` on a trip wire's line lies on the wire itself (between its ends)."""
+    ex, ey = a2 - a0, a3 - a1
+    u = (x - a0) * ex + (y - a1) * ey
+    return 0.0 <= u <= ex * ex + ey * ey
+
+
 def predict(
     x: float, y: float, vx: float, vy: float, ax: float, ay: float, drag: float,
     shape: float, a0: float, a1: float, a2: float, a3: float, inside: bool,
@@ -291,5 +311,7 @@ PARTS = (
     accelerated_leave,
     _linear_leave,
     circle_time,
+    contains,
+    on_wire,
     predict,
 )

@@ -19,10 +19,11 @@ from discsim.engines.event_driven.numba.reads import CompiledReads
 from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.state import EventDrivenState
 from discsim.errors import InvalidArgumentError
-from discsim.events import EVENT_DTYPE, SPIN_DTYPE, EventKind, EventLog
+from discsim.events import EVENT_DTYPE, SENSED, SPIN_DTYPE, EventKind, EventLog
 from discsim.laws import Laws
 from discsim.physics import dynamics
 from discsim.scene import Scene
+from discsim.sensors import inside_table, sensor_rows
 
 __all__ = ["NumbaBackend"]
 
@@ -107,7 +108,8 @@ class NumbaBackend(CompiledReads):
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
         self._lp = _loop()
         self._law_of_motion = law_of_motion or dynamics
-        if not self.laws.default:  # the loop that reads the laws (one for every value of them)
+        if not self.laws.default or scene.sensors:  # the loop that reads the laws (one for every value of them)
+            # and the sensors
             self._lp = SimpleNamespace(**_variants().with_laws(interpreted=interpreted))
         elif law_of_motion is not None or collision_law is not None or interpreted:
             variants = _variants()
@@ -128,14 +130,22 @@ class NumbaBackend(CompiledReads):
                 self.laws.array(scene.discs.radii),
             ]
         )
-        segments = scene.segments
+        # The segments' rows (end points), then the sensors' (numbers, shape code, index: sensor_rows), with the
+        # rows each cell must check: the segments within reach of it, the regions over it, every trip wire.
+        segments, sensors = scene.segments, scene.sensors
+        self._seg = np.zeros((len(segments) + len(sensors), 6))
+        near: list = [()] * len(grid)
         if segments:
-            self._seg = np.array([[*s.p0.tolist(), *s.p1.tolist()] for s in segments], dtype=np.float64)
+            self._seg[: len(segments), :4] = [[*s.p0.tolist(), *s.p1.tolist()] for s in segments]
             reach = float(np.max(scene.discs.radii)) if len(scene) else 0.0
             near = grid.segments_by_cell(segments, reach)
-        else:
-            self._seg = np.zeros((0, 4))
-            near = [()] * len(grid)
+        if sensors:
+            self._seg[len(segments) :, :5] = sensor_rows(sensors)
+            self._seg[len(segments) :, 5] = np.arange(len(sensors))
+            near = [list(cell) for cell in near]
+            for k, sensor in enumerate(sensors):
+                for c in _sensor_cells(grid, sensor):
+                    near[c].append(len(segments) + k)
         sizes = np.array([len(s) for s in near], dtype=np.int64)
         self._seg_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         self._seg_idx = np.array([k for s in near for k in s], dtype=np.int64)
@@ -210,7 +220,8 @@ class NumbaBackend(CompiledReads):
         ints[lp.I_LKIND] = state.last_kind
         if state.last_kind >= 0:
             ints[lp.I_LI] = rank[state.last_i]
-            ints[lp.I_LJ] = rank[state.last_j] if state.last_j >= 0 else state.last_j
+            pair = state.last_j >= 0 and state.last_kind not in SENSED  # a sensor's j is the sensor's index
+            ints[lp.I_LJ] = rank[state.last_j] if pair else state.last_j
         else:
             ints[lp.I_LI] = ints[lp.I_LJ] = -1
         floats[lp.F_EPOCH] = state.epoch
@@ -220,7 +231,14 @@ class NumbaBackend(CompiledReads):
         floats[lp.F_LTIME] = state.last_time
         floats[lp.F_LOST] = state.dissipated
         ints[lp.I_RESTS] = state.rests
-        self._rest = state.resting[order].astype(np.int8)
+        ints[lp.I_SENSE] = state.sensor_events
+        # Each disc's rest flag, then its side of each sensor (disc-major: n + i S + k; one array, so that
+        # predict takes no more arguments than it may: see the edges above).
+        sensed, sensors = state.sensed, self.scene.sensors
+        if sensed.shape != (n, len(sensors)):  # not kept (no sensor before): where the discs are now
+            gravity = self.laws.gravity if self.laws.falls else None
+            sensed = inside_table(sensors, state.positions_at(state.time, gravity, drag=self.laws.drag))
+        self._rest = np.concatenate([state.resting[order], sensed[order].ravel()]).astype(np.int8)
         self._tlast = state.last_collision[order].astype(np.float64)
         self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
@@ -257,7 +275,8 @@ class NumbaBackend(CompiledReads):
             last = (0.0, -1, -1, -1)
         else:
             i, j = int(ints[lp.I_LI]), int(ints[lp.I_LJ])
-            last = (float(floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if j >= 0 else j)
+            pair = j >= 0 and int(ints[lp.I_LKIND]) not in SENSED
+            last = (float(floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if pair else j)
         return EventDrivenState(
             time=float(floats[lp.F_TIME]),
             epoch=float(floats[lp.F_EPOCH]),
@@ -293,10 +312,12 @@ class NumbaBackend(CompiledReads):
             queue_kind=kinds,
             queue_other=np.where(kinds == _COLLISION, order[np.where(kinds == _COLLISION, others, 0)], others),
             queue_stamp=self._qs[owners].copy(),
-            resting=caller(self._rest),
+            resting=caller(self._rest[:n]),
+            sensed=caller(self._rest[n:].reshape(n, len(self.scene.sensors))).astype(np.int64),
             last_collision=caller(self._tlast),
             dissipated=float(floats[lp.F_LOST]),
             rests=int(ints[lp.I_RESTS]),
+            sensor_events=int(ints[lp.I_SENSE]),
             spins=spins,
             angles=angles,
         )
@@ -380,6 +401,9 @@ class NumbaBackend(CompiledReads):
         if position is not None:
             x, y = float(position[0]), float(position[1])
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
+        if position is not None and self.scene.sensors:  # moved: its sides of the sensors are where it is now
+            sensors, n = self.scene.sensors, len(rec)
+            self._rest[n + k * len(sensors) : n + (k + 1) * len(sensors)] = inside_table(sensors, [[x, y]])[0]
         held: list[int] = []
         if self.laws.falls and self._rest[k] != 0:  # a support at rest moves: what it held up falls again
             gx, gy = self.laws.gravity
@@ -427,6 +451,18 @@ _NO_EVENTS = (
     np.empty((0, 8)),
     np.empty((0, 2)),
 )
+
+
+def _sensor_cells(grid: CellGrid, sensor) -> list[int]:
+    """The cells a disc's centre may cross ``sensor``'s edge from: over its bounds (a hair wider, for a centre on a
+    cell's edge), or every cell for a trip wire (its side changes wherever the line runs, beyond the wire too)."""
+    if sensor.shape == "line":
+        return list(range(len(grid)))
+    x0, y0, x1, y1 = sensor.bounds()
+    hair = 1e-9 * max(grid.box.width, grid.box.height)
+    cx0, cx1 = (int(np.clip(np.floor(v / grid.lx), 0, grid.nx - 1)) for v in (x0 - hair, x1 + hair))
+    cy0, cy1 = (int(np.clip(np.floor(v / grid.ly), 0, grid.ny - 1)) for v in (y0 - hair, y1 + hair))
+    return [cx * grid.ny + cy for cx in range(cx0, cx1 + 1) for cy in range(cy0, cy1 + 1)]
 
 
 def _records(events, k: int) -> np.ndarray:

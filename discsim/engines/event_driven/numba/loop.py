@@ -71,6 +71,9 @@ from discsim.physics.compiled import (
     reflect_off_segment,
     rough_impulse,
     segment_time_of_impact,
+    sensor_contains,
+    sensor_on_wire,
+    sensor_predict,
 )
 from discsim.physics.sources.boundaries import MINUS_X, MINUS_Y, PLUS_X, PLUS_Y
 
@@ -78,9 +81,11 @@ INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT, SET = (
     int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT, EventKind.SET)
 )
+SENSOR, ENTER, LEAVE = int(EventKind.SENSOR), int(EventKind.ENTER), int(EventKind.LEAVE)
+LINE = 3.0  # a trip wire's shape code (discsim.sensors.LINE)
 # Slots of ``ints``.
-I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS = range(12)
-N_INTS = 12
+I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS, I_SENSE = range(13)
+N_INTS = 13
 if I_SIZE != blocks.I_SIZE:  # the queue (blocks.py) counts its events in the same slot
     raise ImportError("blocks.I_SIZE is not the loop's I_SIZE")
 # Slots of ``floats``.
@@ -209,7 +214,15 @@ def predict(
         best, kind, other = ty, kind_y, other_y
     for m in range(seg_start[c], seg_start[c + 1]):
         k = seg_idx[m]
-        if k != -2 - exclude:  # not the segment just left
+        if LAWS and seg[k, 4] != 0.0:  # a sensor (row k of seg): when i's centre next changes sides of it
+            n = rec.shape[0]
+            ts = sensor_predict(
+                xi, yi, vxi, vyi, axi, ayi, drag, seg[k, 4], seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
+                rest[n + i * ((rest.shape[0] - n) // n) + int(seg[k, 5])] != 0,
+            )  # fmt: skip
+            if ts < best:
+                best, kind, other = ts, SENSOR, k
+        elif k != -2 - exclude:  # not the segment just left
             ts = segment_time_of_impact(
                 xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi, drag
             )
@@ -305,6 +318,18 @@ def _prefetch_cells(c, head, nx, ny):
         prefetch(head, ox * ny + c - cx * ny)
 
 
+@jit
+def resense(i, t, gravity, gx, gy, drag, rec, rest, seg):
+    """Take disc ``i``'s side of every sensor from where its centre is at ``t`` (after a jump across the box)."""
+    n = rec.shape[0]
+    n_sensors = (rest.shape[0] - n) // n
+    axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+    xi, yi, _, _ = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
+    for k in range(seg.shape[0] - n_sensors, seg.shape[0]):
+        inside = sensor_contains(seg[k, 4], seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], xi, yi)
+        rest[n + i * n_sensors + int(seg[k, 5])] = 1 if inside else 0
+
+
 # --- the hot loop --------------------------------------------------------------------------------------
 @jit
 def rebase(shift, rec, qt, bheap, bht, bpos, barg, floats):
@@ -348,7 +373,7 @@ def run_events(
     if LAWS:
         beta = law[BETA]
     rough = LAWS and beta != -1.0
-    n_coll = n_wall = n_cross = n_stale = 0
+    n_coll = n_wall = n_cross = n_stale = n_sense = 0
     done = 0
     logged = 0
     capacity = ev_t.shape[0]
@@ -606,6 +631,36 @@ def run_events(
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
+        elif LAWS and kind == SENSOR:  # i's centre changes sides of sensor row ``other``: the path goes on
+            n = rec.shape[0]
+            s = int(seg[other, 5])
+            slot = n + i * ((rest.shape[0] - n) // n) + s
+            entering = rest[slot] == 0
+            rest[slot] = 1 if entering else 0
+            axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
+            # A trip wire reports only crossings of the wire itself (beyond its ends only the side changes).
+            if seg[other, 4] != LINE or sensor_on_wire(seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], xi, yi):
+                sensed = ENTER if entering else LEAVE
+                n_sense += 1
+                done += 1
+                if recording:
+                    ev_t[logged] = t + epoch
+                    ev_kind[logged] = sensed
+                    ev_i[logged] = order[i]
+                    ev_j[logged] = s
+                    ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, vxi, vyi
+                    ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
+                    if rough:
+                        ev_w[logged, 0], ev_w[logged, 1] = rot[i, W], np.nan
+                    logged += 1
+                last_time, last_kind, last_i, last_j = t + epoch, sensed, i, s
+            predict(
+                i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                nx, ny, periodic, edges,
+                seg, seg_start, seg_idx, group, blocked, rest,
+                qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
+            )  # fmt: skip
         else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
             c = cell[i]
             _leave(i, c, head, nxt)
@@ -616,6 +671,9 @@ def run_events(
             elif wrap_y != 0:
                 rec[i, Y] = rec[i, Y] - wrap_y * height
                 images[i, 1] += wrap_y
+            if LAWS and (wrap_x != 0 or wrap_y != 0) and rest.shape[0] > rec.shape[0]:
+                # Across the periodic box's edge: the sides of trip wires may differ here (regions lie inside)
+                resense(i, t, gravity, gx, gy, drag, rec, rest, seg)
             c = cx * ny + cy
             cell[i] = c
             _enter(i, c, head, nxt)
@@ -651,9 +709,10 @@ def run_events(
     ints[I_WALL] += n_wall
     ints[I_CROSS] += n_cross
     ints[I_STALE] += n_stale
+    ints[I_SENSE] += n_sense
     return done, n_cross, logged, why
 
 
 #: The functions above that call the physics parts (directly or through ``predict``), callees first: the ones
 #: :mod:`~discsim.engines.event_driven.numba.variants` compiles anew.
-PHYSICAL = ("predict", "predict_all", "set_disc", "run_events")
+PHYSICAL = ("predict", "predict_all", "set_disc", "resense", "run_events")

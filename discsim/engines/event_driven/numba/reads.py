@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from discsim.events import SENSED
 from discsim.physics.dynamics import advance_many
 
 __all__ = ["CompiledReads"]
@@ -77,7 +78,7 @@ class CompiledReads:
 
     def counts(self) -> dict[str, int]:
         """``collisions``, ``wall_hits``, ``cell_crossings``, ``stale``, ``predictions`` (and ``rests``, discs
-        put to rest, under gravity)."""
+        put to rest, under gravity; ``sensor_events``, enter and leave events, with sensors)."""
         lp, ints = self._lp, self._ints
         counts = {
             "collisions": int(ints[lp.I_COLL]),
@@ -88,6 +89,8 @@ class CompiledReads:
         }
         if self.laws.falls:
             counts["rests"] = int(ints[lp.I_RESTS])
+        if self.scene.sensors:
+            counts["sensor_events"] = int(ints[lp.I_SENSE])
         return counts
 
     @property
@@ -161,9 +164,10 @@ class CompiledReads:
         lp, ints = self._lp, self._ints
         if ints[lp.I_LKIND] < 0:
             return None
-        i, j = int(ints[lp.I_LI]), int(ints[lp.I_LJ])
+        i, j, kind = int(ints[lp.I_LI]), int(ints[lp.I_LJ]), int(ints[lp.I_LKIND])
         order = self._order
-        return float(self._floats[lp.F_LTIME]), int(ints[lp.I_LKIND]), int(order[i]), int(order[j]) if j >= 0 else j
+        pair = j >= 0 and kind not in SENSED  # a sensor's j is the sensor's index
+        return float(self._floats[lp.F_LTIME]), kind, int(order[i]), int(order[j]) if pair else j
 
     def _rank(self) -> np.ndarray:
         """Internal number of each caller's disc, ``(N,)`` (built when asked: O(N), as every read that needs it)."""

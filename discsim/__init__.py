@@ -56,13 +56,13 @@ from discsim.io.gsd import read_gsd, write_gsd
 from discsim.io.streams import StreamedEvents, iter_events, read_events, trajectory_from_events
 from discsim.io.xyz import read_xyz, write_xyz
 from discsim.model import Box, Discs, Segment, polygon
-from discsim.sensors import Sensor
 from discsim.run import driver as _driver  # noqa: F401 (it provides Engine.run: discsim.engines.base.provide)
 from discsim.run import tasks
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
 from discsim.run.samplers import GSDWriter, Sampler
 from discsim.run.sweep import sweep
 from discsim.scenarios import Scenario, billiard_break, head_on, newtons_cradle, random_gas, study_cases
+from discsim.sensors import Sensor
 from discsim.spatial import RayHit
 from discsim.view import View, view  # cheap (no matplotlib); binds ds.view to the function, not the module
 

@@ -18,7 +18,6 @@ __all__ = [
     "ADD",
     "COLLISION",
     "ENTER",
-    "Crossing",
     "EVENT_DTYPE",
     "KIND_NAMES",
     "LEAVE",
@@ -27,10 +26,13 @@ __all__ = [
     "SET",
     "SPIN_DTYPE",
     "WALL",
+    "Crossing",
     "Event",
     "EventKind",
     "EventLog",
     "added_discs",
+    "disc_count",
+    "disc_partners",
     "event_from_record",
 ]
 
@@ -105,6 +107,19 @@ class Crossing(NamedTuple):
     sensor: int
     position: np.ndarray
     velocity: np.ndarray
+
+
+def disc_partners(events: np.ndarray) -> np.ndarray:
+    """``(R,)`` bool: the records of ``events`` whose ``j`` names a disc (not a wall hit's -1, nor a sensor's index)."""
+    return (events["j"] >= 0) & (events["kind"] != ENTER) & (events["kind"] != LEAVE)
+
+
+def disc_count(events: np.ndarray) -> int:
+    """One more than the largest disc id ``events`` name (0 for none)."""
+    if not len(events):
+        return 0
+    j = events["j"][disc_partners(events)]
+    return int(max(events["i"].max(), j.max(initial=-1))) + 1
 
 
 def event_from_record(record) -> Event:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim.errors import InvalidArgumentError, TimeError
-from discsim.events import EventKind, added_discs
+from discsim.events import EventKind, added_discs, disc_count, disc_partners
 from discsim.model import image_steps
 from discsim.physics.dynamics import advance, advance_many
 
@@ -186,7 +186,7 @@ def _sorted_records(events, positions0, velocities0, time0, kinds: bool = False)
         t_recs.append(times)
         seqs.append(np.arange(len(events)))
         states.append(np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]))
-        pair = np.flatnonzero(events["j"] >= 0)
+        pair = np.flatnonzero(disc_partners(events))
         discs.append(events["j"][pair])  # field by field: gathering whole 89-byte rows is slower
         t_recs.append(times[pair])
         seqs.append(pair)
@@ -300,7 +300,7 @@ class LastRecords:
         m, rows = len(self), np.arange(len(records))
         as_i, as_j = np.full(m, -1), np.full(m, -1)
         np.maximum.at(as_i, records["i"], rows)
-        pair = records["j"] >= 0
+        pair = disc_partners(records)
         np.maximum.at(as_j, records["j"][pair], rows[pair])
         times, positions, velocities = self.times.copy(), self.positions.copy(), self.velocities.copy()
         still = self.still.copy()
@@ -328,7 +328,7 @@ class LastRecords:
         if not len(records):
             return self
         added, _, _, _, radii, masses, groups = added_discs(records)
-        top = int(max(records["i"].max(), records["j"].max())) + 1
+        top = disc_count(records)
         base = self.grown(top)
         m = len(base)
         shifts = unwrapped and box is not None and box.periodic
@@ -508,7 +508,7 @@ def replay(chunks, start: LastRecords, times, box, *, unwrapped: bool = False, v
 def _evaluate(records, carry: LastRecords, times, box, unwrapped: bool, velocities: bool, gravity=None):
     """Positions (and velocities) ``(T, M, 2)`` at sorted ``times`` from ``carry`` and one chunk of ``records``."""
     if len(records):
-        carry = carry.grown(int(max(records["i"].max(), records["j"].max())) + 1)
+        carry = carry.grown(disc_count(records))
     positions = reconstruct(
         records,
         carry.positions,
@@ -589,7 +589,7 @@ def turning_history(events, spin_events, spins0, time0: float, angles0=None) -> 
         if len(rows) != len(spin_events) or not np.array_equal(events["time"][rows], spin_events["time"]):
             msg = f"{len(spin_events)} spin rows for {len(rows)} collisions and wall hits in the log"
             raise ValueError(msg)
-        pair = events["j"][rows] >= 0
+        pair = disc_partners(events[rows])
         discs += [events["i"][rows], events["j"][rows][pair]]
         t_recs += [events["time"][rows], events["time"][rows][pair]]
         seqs += [rows, rows[pair]]

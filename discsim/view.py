@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import ADD, COLLISION, EVENT_DTYPE, EventKind
+from discsim.events import ADD, COLLISION, EVENT_DTYPE, EventKind, disc_count, disc_partners
 from discsim.trajectory import LastRecords, falling, flight, turning_history
 
 if TYPE_CHECKING:
@@ -102,7 +102,7 @@ def _engine_turning(sim, events: np.ndarray, discs, ids) -> tuple | None:
     if not rough and not np.any(discs.spins):
         return None
     ids = np.arange(len(discs)) if ids is None else np.asarray(ids)
-    top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
+    top = disc_count(events)
     spins0 = np.zeros(max(top, int(ids.max()) + 1 if len(ids) else 0))
     spins0[ids] = discs.spins
     try:
@@ -302,15 +302,15 @@ def _records(span: _Span, t0: float):
     arithmetic, as ``trajectory()``.
     """
     events = span.events
-    top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
+    top = disc_count(events)
     before = span.before.grown(top)
     n = len(before)
-    pair = np.flatnonzero(events["j"] >= 0)
+    pair = np.flatnonzero(disc_partners(events))
     ev = events[pair]
     disc = np.concatenate([np.arange(n), events["i"], ev["j"]])
     times = np.concatenate([before.times, events["time"], ev["time"]])
     seq = np.concatenate([np.full(n, -1), np.arange(len(events)), pair])
-    partner = np.concatenate([np.full(n, -2), events["j"], ev["i"]])
+    partner = np.concatenate([np.full(n, -2), np.where(disc_partners(events), events["j"], -1), ev["i"]])
     kind = np.concatenate([np.where(before.still, int(EventKind.WALL), -1), events["kind"], ev["kind"]])
     states = np.vstack(
         [
@@ -333,7 +333,7 @@ def _records(span: _Span, t0: float):
 def _discs_of(span: _Span) -> LastRecords:
     """Every disc id the span shows, with radii, masses and groups (those added in the span included)."""
     events = span.events
-    top = int(max(events["i"].max(), events["j"].max())) + 1 if len(events) else 0
+    top = disc_count(events)
     return span.before.after(events[events["kind"] == ADD]).grown(top) if len(events) else span.before
 
 

@@ -10,7 +10,18 @@ from paths import PACKAGE
 
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
-    "ground": ["model", "sensors", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled", "_progress", "_version"],
+    "ground": [
+        "model",
+        "sensors",
+        "queue",
+        "errors",
+        "_validate",
+        "_interrupt",
+        "_numba",
+        "_compiled",
+        "_progress",
+        "_version",
+    ],
     "model": ["scene", "laws", "events", "cells", "repair", "spatial"],
     "physics": ["physics", "kernels", "trajectory", "losses"],
     "engines": ["engines"],

@@ -20,7 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION, WALL
+from discsim.events import COLLISION, WALL, disc_partners
 from discsim.trajectory import log_start
 
 __all__ = ["Contact", "Contacts", "contact_of_record", "contacts", "contacts_of"]
@@ -132,7 +132,7 @@ def contacts(source, discs=None, box=None, segments=()) -> Contacts:
 def contacts_of(events, velocities, masses, radii, box, segments=()) -> Contacts:
     """:func:`contacts` of ``events`` given every disc's ``velocities`` ``(N, 2)`` before the first record."""
     n_ev = len(events)
-    pair = np.flatnonzero(events["j"] >= 0)
+    pair = np.flatnonzero(disc_partners(events))
     disc = np.concatenate([events["i"], events["j"][pair]]).astype(np.int64)
     row = np.concatenate([np.arange(n_ev), pair])
     after = np.concatenate(

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import COLLISION
+from discsim.events import COLLISION, disc_count, disc_partners
 
 __all__ = ["MSD", "VACF", "FreeTimes", "free_times", "free_times_of", "msd", "vacf"]
 
@@ -260,7 +260,7 @@ def _collision_records(events: np.ndarray, masses: np.ndarray | None, walls: boo
     if walls:
         kinds = np.ones(len(events), dtype=bool)
     rows = events[kinds]
-    pair = rows["j"] >= 0
+    pair = disc_partners(rows)
     disc = np.concatenate([rows["i"], rows["j"][pair]])
     time = np.concatenate([rows["time"], rows["time"][pair]])
     seq = np.concatenate([np.arange(len(rows)), np.flatnonzero(pair)])
@@ -345,7 +345,7 @@ def free_times(source, *, walls: bool = False, since: float | None = None) -> Fr
             chunks, start_discs, _, _, _, _ = log_source(source, "free_times()")
             events = np.concatenate(list(chunks()))
             masses = np.asarray(start_discs.masses, dtype=float)
-        n = int(max(events["i"].max(initial=-1), events["j"].max(initial=-1))) + 1
+        n = disc_count(events)
         times, discs, start, _ = free_times_of(events, np.full(n, np.nan), masses, walls)
     if since is not None:
         keep = start > since

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import ADD, REMOVE
+from discsim.events import ADD, REMOVE, disc_partners
 from discsim.model import Box, Discs
 from discsim.trajectory import LastRecords, check_times, flight, reconstruct, replay, turning_at, turning_history
 
@@ -127,7 +127,7 @@ def states_at(events: np.ndarray, positions0, velocities0, time0: float, times, 
         t_recs.append(events["time"])
         seqs.append(np.arange(len(events)))
         vels.append(np.column_stack([events["vxi"], events["vyi"]]))
-        pair = np.flatnonzero(events["j"] >= 0)
+        pair = np.flatnonzero(disc_partners(events))
         discs.append(events["j"][pair])
         t_recs.append(events["time"][pair])
         seqs.append(pair)

@@ -109,7 +109,9 @@ class RunStops:
         last = old.last_event()
         old.time = time
         now = self.snapshot()
-        scene = Scene(now, self.box, self.scene.segments, self.scene.pass_through, sensors=self.scene.sensors, check=False)
+        scene = Scene(
+            now, self.box, self.scene.segments, self.scene.pass_through, sensors=self.scene.sensors, check=False
+        )
         self._restructure(np.arange(len(now)), None, scene, last)
 
     #: A run raises :class:`~discsim.errors.JammedError` after ``jam_events + jam_events_per_disc * N``

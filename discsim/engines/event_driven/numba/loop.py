@@ -640,7 +640,9 @@ def run_events(
             axi, ayi = accel(i, gravity, gx, gy, rec, rest)
             xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
             # A trip wire reports only crossings of the wire itself (beyond its ends only the side changes).
-            if seg[other, 4] != LINE or sensor_on_wire(seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], xi, yi):
+            if seg[other, 4] != LINE or sensor_on_wire(
+                seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], xi, yi
+            ):
                 sensed = ENTER if entering else LEAVE
                 n_sense += 1
                 done += 1

@@ -20,6 +20,7 @@ class CompiledReads:
     builds (``_rec``, ``_ints``, ``_floats``, ``_order`` ...; see :mod:`discsim.engines.event_driven.numba.loop`)."""
 
     _lp: Any
+    scene: Any
     _rec: np.ndarray
     _ints: np.ndarray
     _floats: np.ndarray

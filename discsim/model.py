@@ -433,25 +433,31 @@ def frame_count(start: float, end: float, dt: float) -> int:
 
 
 class Segment:
-    """A fixed line-segment wall from ``p0`` to ``p1`` (both sides reflect).
+    """A line-segment wall from ``p0`` to ``p1`` (both sides reflect), fixed or moving at a constant velocity.
 
     Segments build polygonal tables (a triangle, a stadium's straight sides)
-    inside a walled box. Discs bounce off the face and off the end points.
+    inside a walled box. Discs bounce off the face and off the end points. A segment given a ``velocity`` is
+    kinematic (a paddle, a pusher, a conveyor's edge): it moves at that velocity for ever, whatever hits it,
+    and a disc bounces off it in its own frame (``EventDriven`` only, under the default laws or restitution).
 
     Args:
-        p0, p1: end points ``(2,)`` in length units; finite and distinct.
+        p0, p1: end points ``(2,)`` in length units at time 0; finite and distinct.
+        velocity: ``(2,)`` the segment's velocity (length / time; finite); default ``(0, 0)``: fixed.
 
     Example:
         >>> Segment((0, 0), (3, 4)).length
         5.0
+        >>> Segment((0, 0), (0, 1), velocity=(2, 0)).at(1.5)
+        Segment([3.0, 0.0], [3.0, 1.0], velocity=[2.0, 0.0])
     """
 
-    __slots__ = ("p0", "p1")
+    __slots__ = ("p0", "p1", "velocity")
 
-    def __init__(self, p0, p1):
+    def __init__(self, p0, p1, velocity=(0.0, 0.0)):
         a = _real_array("segment p0", p0)
         b = _real_array("segment p1", p1)
-        for name, p in (("p0", a), ("p1", b)):
+        v = _real_array("segment velocity", velocity)
+        for name, p in (("p0", a), ("p1", b), ("velocity", v)):
             if p.shape != (2,) or not np.isfinite(p).all():
                 msg = f"segment {name} must be 2 finite numbers, got {p.tolist()}"
                 raise InvalidDiscsError(msg)
@@ -460,6 +466,19 @@ class Segment:
             raise InvalidDiscsError(msg)
         self.p0 = _readonly(a)
         self.p1 = _readonly(b)
+        self.velocity = _readonly(v + 0.0)  # (-0.0 -> 0.0)
+
+    @property
+    def moving(self) -> bool:
+        """Whether the segment has a velocity."""
+        return bool(self.velocity.any())
+
+    def at(self, time: float) -> Segment:
+        """The segment where it is at ``time`` (itself if it does not move)."""
+        if not self.moving:
+            return self
+        shift = self.velocity * float(time)
+        return Segment(self.p0 + shift, self.p1 + shift, self.velocity)
 
     @property
     def length(self) -> float:
@@ -475,6 +494,8 @@ class Segment:
         return np.hypot(*(points - nearest).T)
 
     def __repr__(self) -> str:
+        if self.moving:
+            return f"Segment({self.p0.tolist()}, {self.p1.tolist()}, velocity={self.velocity.tolist()})"
         return f"Segment({self.p0.tolist()}, {self.p1.tolist()})"
 
 

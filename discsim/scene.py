@@ -274,6 +274,11 @@ class Scene:
         self.group, self.blocked = filter_table(discs.groups, self.pass_through)
 
     @property
+    def moving(self) -> bool:
+        """True when some segment moves."""
+        return any(segment.moving for segment in self.segments)
+
+    @property
     def filtering(self) -> bool:
         """True when some groups pass through each other."""
         return bool(self.pass_through)

@@ -183,10 +183,15 @@ def contacts_of(events, velocities, masses, radii, box, segments=()) -> Contacts
         speed[walls] = np.einsum("ij,ij->i", vi0[walls], nrm)
         p, r = ri[walls], radii[i[walls]]
         gaps = [p[:, 0] - r, box.width - r - p[:, 0], p[:, 1] - r, box.height - r - p[:, 1]]
-        gaps += [seg.distance(p) - r for seg in segments]
+        when = ev["time"][walls][:, None]
+        gaps += [seg.distance(p - seg.velocity * when) - r for seg in segments]  # (a moving one where it was then)
         nearest = np.argmin(np.abs(np.column_stack(gaps)), axis=1)
         surface[walls] = np.where(nearest < 4, -1 - nearest, nearest - 4)
         kind[walls] = np.where(nearest < 4, "wall", "segment")
+        for s, seg in enumerate(segments):  # a moving segment's speed of approach is in its frame
+            hit = nearest == 4 + s
+            if seg.moving and hit.any():
+                speed[walls[hit]] -= nrm[hit] @ seg.velocity
     point = ri + normal * radii[i][:, None]
     if box.periodic:
         point = box.wrap(point)
@@ -228,9 +233,12 @@ def contact_of_record(rec, i: int, j: int, before_i, before_j, masses, radii, bo
         impulse = mi * size
         speed = vxi0 * nx + vyi0 * ny
         gaps = [xi - ri, box.width - ri - xi, yi - ri, box.height - ri - yi]
-        gaps += [float(seg.distance(np.array([[xi, yi]]))[0]) - ri for seg in segments]
+        gaps += [float(seg.distance(np.array([[xi, yi]]) - seg.velocity * t)[0]) - ri for seg in segments]
         nearest = min(range(len(gaps)), key=lambda k: abs(gaps[k]))
         kind, surface = ("wall", -1 - nearest) if nearest < 4 else ("segment", nearest - 4)
+        if nearest >= 4 and segments[nearest - 4].moving:  # its speed of approach in the segment's frame
+            u = segments[nearest - 4].velocity
+            speed -= nx * float(u[0]) + ny * float(u[1])
     px, py = xi + nx * ri, yi + ny * ri
     if box.periodic:
         px, py = (float(v) for v in box.wrap(np.array([px, py])))

@@ -170,7 +170,7 @@ class DiscEditing:
         now = self.snapshot()
         everyone = Discs(*(np.concatenate([getattr(now, name), getattr(discs, name)]) for name in _DISC_FIELDS))
         scene = self.scene
-        check_added(everyone, self.box, n, scene.segments, scene.pass_through)
+        check_added(everyone, self.box, n, [s.at(self.time) for s in scene.segments], scene.pass_through)
         new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, sensors=scene.sensors, check=False)
         context = self.run_context
         ids = np.arange(context.next_id, context.next_id + k, dtype=np.int64)
@@ -387,6 +387,7 @@ class DiscEditing:
                 msg = f"disc {i} at {p.tolist()} with radius {r:g} would be {what} (box {box.width:g} x {box.height:g})"
                 raise OutsideBoxError(msg)
             for s, segment in enumerate(self.segments):
+                segment = segment.at(self.time)  # (where a moving one is now)
                 if float(segment.distance(p[None, :])[0]) < r * (1.0 - OVERLAP_TOLERANCE):
                     msg = f"disc {i} at {p.tolist()} with radius {r:g} would be cut by segment {s} {segment!r}"
                     raise OutsideBoxError(msg)

@@ -47,7 +47,8 @@ class SpatialQueries:
         key = (self.time, self._units(), self._edits, len(self.discs))
         cached = getattr(self, "_spatial_cache", None)
         if cached is None or cached[0] != key:
-            cached = (key, SpatialIndex(self.positions, self._radii_now(), self.box, self.segments))
+            segments = [segment.at(self.time) for segment in self.segments]  # where the moving ones are now
+            cached = (key, SpatialIndex(self.positions, self._radii_now(), self.box, segments))
             self._spatial_cache = cached
         return cached[1]
 

@@ -76,7 +76,9 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         "counts": dict(engine.counts),
         "box": box.as_dict(),
         "scene": {
-            "segments": [[*s.p0.tolist(), *s.p1.tolist()] for s in scene.segments],
+            "segments": [
+                [*s.p0.tolist(), *s.p1.tolist(), *(s.velocity.tolist() if s.moving else [])] for s in scene.segments
+            ],  # fmt: skip
             "pass_through": sorted(scene.pass_through),
             "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in scene.sensors],
         },
@@ -235,7 +237,8 @@ def load(path, *, backend: str | None = None):
             scene_meta, settings, state, events = _first_layout(engine, meta, arrays)
         if backend is not None or (settings.get("backend") == "numba" and not numba_available()):
             settings = {**settings, "backend": backend or "auto"}
-        segments = [Segment(row[:2], row[2:]) for row in scene_meta.get("segments", [])]
+        segments = [Segment(row[:2], row[2:4], row[4:6] if len(row) > 4 else (0.0, 0.0))
+                    for row in scene_meta.get("segments", [])]  # fmt: skip
         pass_through = [tuple(pair) for pair in scene_meta.get("pass_through", [])]
         sensors = [Sensor(int(row[0]), row[1:]) for row in scene_meta.get("sensors", [])]
         if changed:

@@ -156,6 +156,13 @@ class EventDriven(Turning, RunStops, Engine):
                         f"(gravity={laws.gravity}, drag={laws.drag}); a rectangle or lines work"
                     )
                     raise InvalidArgumentError(msg)
+        if scene.moving and (laws.falls or laws.drag or laws.rough):
+            k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
+            msg = (
+                f"segments[{k}] {scene.segments[k]!r} moves: moving segments run under the default laws or "
+                f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
+            )
+            raise InvalidArgumentError(msg)
         self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()
 
@@ -167,7 +174,7 @@ class EventDriven(Turning, RunStops, Engine):
         self._auto = isinstance(backend, str) and backend == "auto"
         #: physical events the Python loop still runs before ``"auto"`` takes the compiled one (None: no switch)
         self._auto_events: int | None = None
-        compiled_laws = not laws.default or bool(scene.sensors)  # the loop that reads the laws and the sensors
+        compiled_laws = not laws.default or bool(scene.sensors) or scene.moving  # the loop that reads the laws
         if self._auto and compiled_laws:  # the interpreted loop is slow: the compiled one from the start
             backend = "numba" if available() else "python"
         elif self._auto:
@@ -186,7 +193,7 @@ class EventDriven(Turning, RunStops, Engine):
     def _new_backend(self, name: str, scene: Scene, grid: CellGrid):
         """The backend ``name`` over the engine's laws: the default laws run on :data:`BACKENDS`; others on the
         compiled loop (``"python"``: that loop's source, interpreted), and so do sensors."""
-        if self.laws.default and not scene.sensors:
+        if self.laws.default and not scene.sensors and not scene.moving:
             return BACKENDS[name](scene, grid, self.queue_kind)
         return NumbaBackend(scene, grid, self.queue_kind, interpreted=name == "python", laws=self.laws)
 

@@ -217,6 +217,10 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
         backend = _choose_backend(backend, policy)
         scene = Scene(discs, box, segments, pass_through)
+        if scene.moving:
+            k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
+            msg = f"segments[{k}] {scene.segments[k]!r} moves: FixedStep moves no segment yet (EventDriven does)"
+            raise InvalidArgumentError(msg)
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws.checked(scene))
         self._load(self._initial_state())
 

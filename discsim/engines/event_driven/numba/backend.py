@@ -108,8 +108,8 @@ class NumbaBackend(CompiledReads):
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
         self._lp = _loop()
         self._law_of_motion = law_of_motion or dynamics
-        if not self.laws.default or scene.sensors:  # the loop that reads the laws (one for every value of them)
-            # and the sensors
+        if not self.laws.default or scene.sensors or scene.moving:  # the loop that reads the laws (one for every
+            # value of them), the sensors and moving segments
             self._lp = SimpleNamespace(**_variants().with_laws(interpreted=interpreted))
         elif law_of_motion is not None or collision_law is not None or interpreted:
             variants = _variants()
@@ -130,15 +130,21 @@ class NumbaBackend(CompiledReads):
                 self.laws.array(scene.discs.radii),
             ]
         )
-        # The segments' rows (end points), then the sensors' (numbers, shape code, index: sensor_rows), with the
-        # rows each cell must check: the segments within reach of it, the regions over it, every trip wire.
+        # The segments' rows (end points now, shape code 0, -, velocity, end points at time 0), then the sensors'
+        # (numbers, shape code, index: sensor_rows), with the rows each cell must check: the segments within reach
+        # of it (a moving one: every cell), the regions over it, every trip wire.
         segments, sensors = scene.segments, scene.sensors
-        self._seg = np.zeros((len(segments) + len(sensors), 6))
+        self._seg = np.zeros((len(segments) + len(sensors), 12))
         near: list = [()] * len(grid)
         if segments:
-            self._seg[: len(segments), :4] = [[*s.p0.tolist(), *s.p1.tolist()] for s in segments]
+            ends = [[*s.p0.tolist(), *s.p1.tolist()] for s in segments]
+            self._seg[: len(segments), :4] = self._seg[: len(segments), 8:] = ends
+            self._seg[: len(segments), 6:8] = [s.velocity.tolist() for s in segments]
             reach = float(np.max(scene.discs.radii)) if len(scene) else 0.0
             near = grid.segments_by_cell(segments, reach)
+            everywhere = [k for k, s in enumerate(segments) if s.moving]
+            if everywhere:
+                near = [tuple(sorted({*cell, *everywhere})) for cell in near]
         if sensors:
             self._seg[len(segments) :, :5] = sensor_rows(sensors)
             self._seg[len(segments) :, 5] = np.arange(len(sensors))
@@ -239,6 +245,10 @@ class NumbaBackend(CompiledReads):
             gravity = self.laws.gravity if self.laws.falls else None
             sensed = inside_table(sensors, state.positions_at(state.time, gravity, drag=self.laws.drag))
         self._rest = np.concatenate([state.resting[order], sensed[order].ravel()]).astype(np.int8)
+        seg = self._seg  # a moving segment's row: where it is at the epoch (as rebase puts it)
+        moving = (seg[:, 6] != 0.0) | (seg[:, 7] != 0.0)
+        seg[moving, 0:2] = seg[moving, 8:10] + seg[moving, 6:8] * state.epoch
+        seg[moving, 2:4] = seg[moving, 10:12] + seg[moving, 6:8] * state.epoch
         self._tlast = state.last_collision[order].astype(np.float64)
         self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).

@@ -223,9 +223,16 @@ def predict(
             if ts < best:
                 best, kind, other = ts, SENSOR, k
         elif k != -2 - exclude:  # not the segment just left
-            ts = segment_time_of_impact(
-                xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi, drag
-            )
+            if LAWS and (seg[k, 6] != 0.0 or seg[k, 7] != 0.0):  # a moving segment: where it is now, in its frame
+                ux, uy = seg[k, 6], seg[k, 7]
+                ts = segment_time_of_impact(
+                    xi, yi, vxi - ux, vyi - uy, ri, seg[k, 0] + ux * t, seg[k, 1] + uy * t, seg[k, 2] + ux * t,
+                    seg[k, 3] + uy * t, axi, ayi, drag,
+                )  # fmt: skip
+            else:
+                ts = segment_time_of_impact(
+                    xi, yi, vxi, vyi, ri, seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], axi, ayi, drag
+                )
             if ts < best:
                 best, kind, other = ts, SEGMENT, k
     if best < 0.0:
@@ -332,8 +339,16 @@ def resense(i, t, gravity, gx, gy, drag, rec, rest, seg):
 
 # --- the hot loop --------------------------------------------------------------------------------------
 @jit
-def rebase(shift, rec, qt, bheap, bht, bpos, barg, floats):
-    """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``."""
+def rebase(shift, rec, qt, bheap, bht, bpos, barg, floats, seg):
+    """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``; a moving
+    segment's row holds where it is at the new origin (from where it was at time 0: the same at every rebase)."""
+    epoch = floats[F_EPOCH] + shift
+    for k in range(seg.shape[0]):
+        if seg[k, 6] != 0.0 or seg[k, 7] != 0.0:
+            seg[k, 0] = seg[k, 8] + seg[k, 6] * epoch
+            seg[k, 1] = seg[k, 9] + seg[k, 7] * epoch
+            seg[k, 2] = seg[k, 10] + seg[k, 6] * epoch
+            seg[k, 3] = seg[k, 11] + seg[k, 7] * epoch
     for i in range(rec.shape[0]):
         rec[i, T] -= shift
         rec[i, KEPT] = rec[i, KEPT] - shift
@@ -567,7 +582,17 @@ def run_events(
                 floats[F_LOST] += drag_loss(i, axi, ayi, rec, xi, yi, vxi, vyi)
             e = restitution(i, i, t + epoch, law, etab, egroup, tlast) if LAWS else 1.0
             wx, wy = vxi, vyi
-            if kind == SEGMENT:
+            fx = fy = 0.0  # the velocity of what it bounces off
+            if LAWS and kind == SEGMENT:
+                fx, fy = seg[other, 6], seg[other, 7]
+            if LAWS and (fx != 0.0 or fy != 0.0):  # a moving segment: the bounce in its frame, where it is now
+                vxi, vyi = reflect_off_segment(
+                    xi, yi, vxi - fx, vyi - fy, seg[other, 0] + fx * t, seg[other, 1] + fy * t,
+                    seg[other, 2] + fx * t, seg[other, 3] + fy * t, e,
+                )  # fmt: skip
+                vxi, vyi = vxi + fx, vyi + fy
+                exclude = -2 - other
+            elif kind == SEGMENT:
                 vxi, vyi = reflect_off_segment(
                     xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], e
                 )
@@ -606,7 +631,16 @@ def run_events(
                     vxi = vyi = 0.0
                     rest[i] = 1
                     ints[I_RESTS] += 1
-            if LAWS and (e != 1.0 or gravity or rough):
+            if LAWS and (fx != 0.0 or fy != 0.0):  # what the bounce took, in the segment's frame (it does work)
+                floats[F_LOST] += (
+                    0.5
+                    * rec[i, M]
+                    * (
+                        ((wx - fx) * (wx - fx) + (wy - fy) * (wy - fy))
+                        - ((vxi - fx) * (vxi - fx) + (vyi - fy) * (vyi - fy))
+                    )
+                )
+            elif LAWS and (e != 1.0 or gravity or rough):
                 floats[F_LOST] += 0.5 * rec[i, M] * ((wx * wx + wy * wy) - (vxi * vxi + vyi * vyi))
             if LAWS and law[TC] > 0.0:
                 tlast[i] = t + epoch
@@ -694,7 +728,7 @@ def run_events(
         now = t
         have_now = True
         if done >= rebase_at:
-            rebase(now, rec, qt, bheap, bht, bpos, barg, floats)
+            rebase(now, rec, qt, bheap, bht, bpos, barg, floats, seg)
             epoch = floats[F_EPOCH]
             now = 0.0
             horizon = until - epoch

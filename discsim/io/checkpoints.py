@@ -78,7 +78,7 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
         "scene": {
             "segments": [
                 [*s.p0.tolist(), *s.p1.tolist(), *(s.velocity.tolist() if s.moving else [])] for s in scene.segments
-            ],  # fmt: skip
+            ],
             "pass_through": sorted(scene.pass_through),
             "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in scene.sensors],
         },

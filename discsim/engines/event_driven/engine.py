@@ -38,6 +38,25 @@ INF = math.inf
 BACKENDS: dict[str, BackendClass] = {"python": PythonBackend, "numba": NumbaBackend}
 
 
+def _check_parts(scene: Scene, laws: Laws) -> None:
+    """Refuse, by name, the sensors and moving segments the loop does not time yet under ``laws``."""
+    if laws.falls and laws.drag:
+        for k, sensor in enumerate(scene.sensors):
+            if sensor.shape == "circle":
+                msg = (
+                    f"sensors[{k}] {sensor!r}: circle sensors are not yet timed under gravity and drag at once "
+                    f"(gravity={laws.gravity}, drag={laws.drag}); a rectangle or lines work"
+                )
+                raise InvalidArgumentError(msg)
+    if scene.moving and (laws.falls or laws.drag or laws.rough):
+        k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
+        msg = (
+            f"segments[{k}] {scene.segments[k]!r} moves: moving segments run under the default laws or "
+            f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
+        )
+        raise InvalidArgumentError(msg)
+
+
 @register_engine
 class EventDriven(Turning, RunStops, Engine):
     """Exact event-driven simulation of hard discs (PIC): elastic by default, or under gravity, with restitution.
@@ -148,21 +167,7 @@ class EventDriven(Turning, RunStops, Engine):
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
         scene = Scene(discs, box, segments, pass_through, sensors=sensors)
-        if laws.falls and laws.drag:
-            for k, sensor in enumerate(scene.sensors):
-                if sensor.shape == "circle":
-                    msg = (
-                        f"sensors[{k}] {sensor!r}: circle sensors are not yet timed under gravity and drag at once "
-                        f"(gravity={laws.gravity}, drag={laws.drag}); a rectangle or lines work"
-                    )
-                    raise InvalidArgumentError(msg)
-        if scene.moving and (laws.falls or laws.drag or laws.rough):
-            k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
-            msg = (
-                f"segments[{k}] {scene.segments[k]!r} moves: moving segments run under the default laws or "
-                f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
-            )
-            raise InvalidArgumentError(msg)
+        _check_parts(scene, laws)
         self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()
 

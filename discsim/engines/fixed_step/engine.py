@@ -76,6 +76,15 @@ DEFAULT_FRAME_RATE = 30.0
 DEFAULT_BISECT_FRACTION = 1e-6
 
 
+def _fixed_segments(scene: Scene) -> Scene:
+    """``scene``, unless a segment moves (refused by name: FixedStep moves no segment yet)."""
+    if scene.moving:
+        k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
+        msg = f"segments[{k}] {scene.segments[k]!r} moves: FixedStep moves no segment yet (EventDriven does)"
+        raise InvalidArgumentError(msg)
+    return scene
+
+
 @register_engine
 class FixedStep(FrameReadout, FixedStepRun, Engine):
     """Fixed-step simulation with a periodic interference test (PIT).
@@ -216,11 +225,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
         backend = _choose_backend(backend, policy)
-        scene = Scene(discs, box, segments, pass_through)
-        if scene.moving:
-            k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
-            msg = f"segments[{k}] {scene.segments[k]!r} moves: FixedStep moves no segment yet (EventDriven does)"
-            raise InvalidArgumentError(msg)
+        scene = _fixed_segments(Scene(discs, box, segments, pass_through))
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws.checked(scene))
         self._load(self._initial_state())
 

@@ -32,10 +32,11 @@ import math
 
 import numpy as np
 
-from discsim._compiled import inline, jit, prefetch
+from discsim._compiled import inline, jit
 from discsim.engines.event_driven.numba import blocks
 from discsim.engines.event_driven.numba.blocks import BLOCK, BLOCK_SHIFT, discard, push, reblock  # noqa: F401
 from discsim.engines.event_driven.numba.cells import _enter, _leave, link, unlink  # noqa: F401
+from discsim.engines.event_driven.numba.sensing import place_segments, resense, sense
 from discsim.engines.event_driven.numba.support import (  # noqa: F401
     ANGLE,
     ANGLE_T,
@@ -49,6 +50,8 @@ from discsim.engines.event_driven.numba.support import (  # noqa: F401
     W,
     X,
     Y,
+    _prefetch_cells,
+    _prefetch_disc,
     accel,
     drag_loss,
     restitution,
@@ -71,8 +74,6 @@ from discsim.physics.compiled import (
     reflect_off_segment,
     rough_impulse,
     segment_time_of_impact,
-    sensor_contains,
-    sensor_on_wire,
     sensor_predict,
 )
 from discsim.physics.sources.boundaries import MINUS_X, MINUS_Y, PLUS_X, PLUS_Y
@@ -81,8 +82,7 @@ INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT, SET = (
     int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT, EventKind.SET)
 )
-SENSOR, ENTER, LEAVE = int(EventKind.SENSOR), int(EventKind.ENTER), int(EventKind.LEAVE)
-LINE = 3.0  # a trip wire's shape code (discsim.sensors.LINE)
+SENSOR = int(EventKind.SENSOR)
 # Slots of ``ints``.
 I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS, I_SENSE = range(13)
 N_INTS = 13
@@ -298,57 +298,12 @@ def set_disc(
         ints[I_MAXQ] = ints[I_SIZE]
 
 
-@inline
-def _prefetch_disc(c, rec, count, kept_partner, kept_stamp, cell, qt, qk, qo, qs):
-    """Ask for every record of disc ``c`` that an event of it reads (see :func:`discsim._compiled.prefetch`)."""
-    prefetch(rec, c * 8)
-    prefetch(count, c)
-    prefetch(kept_partner, c)
-    prefetch(kept_stamp, c)
-    prefetch(cell, c)
-    prefetch(qt, c)
-    prefetch(qk, c)
-    prefetch(qo, c)
-    prefetch(qs, c)
-
-
-@inline
-def _prefetch_cells(c, head, nx, ny):
-    """Start fetching the heads of the 3 x 3 cells around cell ``c`` (three runs of three in memory)."""
-    cx = c // ny
-    for ddx in range(-1, 2):
-        ox = cx + ddx
-        if ox < 0:
-            ox += nx
-        elif ox >= nx:
-            ox -= nx
-        prefetch(head, ox * ny + c - cx * ny)
-
-
-@jit
-def resense(i, t, gravity, gx, gy, drag, rec, rest, seg):
-    """Take disc ``i``'s side of every sensor from where its centre is at ``t`` (after a jump across the box)."""
-    n = rec.shape[0]
-    n_sensors = (rest.shape[0] - n) // n
-    axi, ayi = accel(i, gravity, gx, gy, rec, rest)
-    xi, yi, _, _ = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
-    for k in range(seg.shape[0] - n_sensors, seg.shape[0]):
-        inside = sensor_contains(seg[k, 4], seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3], xi, yi)
-        rest[n + i * n_sensors + int(seg[k, 5])] = 1 if inside else 0
-
-
 # --- the hot loop --------------------------------------------------------------------------------------
 @jit
 def rebase(shift, rec, qt, bheap, bht, bpos, barg, floats, seg):
     """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``; a moving
     segment's row holds where it is at the new origin (from where it was at time 0: the same at every rebase)."""
-    epoch = floats[F_EPOCH] + shift
-    for k in range(seg.shape[0]):
-        if seg[k, 6] != 0.0 or seg[k, 7] != 0.0:
-            seg[k, 0] = seg[k, 8] + seg[k, 6] * epoch
-            seg[k, 1] = seg[k, 9] + seg[k, 7] * epoch
-            seg[k, 2] = seg[k, 10] + seg[k, 6] * epoch
-            seg[k, 3] = seg[k, 11] + seg[k, 7] * epoch
+    place_segments(seg, floats[F_EPOCH] + shift)
     for i in range(rec.shape[0]):
         rec[i, T] -= shift
         rec[i, KEPT] = rec[i, KEPT] - shift
@@ -665,32 +620,17 @@ def run_events(
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
-        elif LAWS and kind == SENSOR:  # i's centre changes sides of sensor row ``other``: the path goes on
-            n = rec.shape[0]
-            s = int(seg[other, 5])
-            slot = n + i * ((rest.shape[0] - n) // n) + s
-            entering = rest[slot] == 0
-            rest[slot] = 1 if entering else 0
-            axi, ayi = accel(i, gravity, gx, gy, rec, rest)
-            xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], axi, ayi, drag)
-            # A trip wire reports only crossings of the wire itself (beyond its ends only the side changes).
-            if seg[other, 4] != LINE or sensor_on_wire(
-                seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], xi, yi
-            ):
-                sensed = ENTER if entering else LEAVE
+        elif LAWS and kind == SENSOR:  # i's centre changes sides of the sensor of row ``other``: the path goes on
+            sensed = sense(
+                i, t, other, epoch, gravity, gx, gy, drag, rough, recording, logged, rec, rest, seg, order, rot,
+                ev_t, ev_kind, ev_i, ev_j, ev_f, ev_w,
+            )  # fmt: skip
+            if sensed >= 0:  # (not beyond a trip wire's ends)
                 n_sense += 1
                 done += 1
                 if recording:
-                    ev_t[logged] = t + epoch
-                    ev_kind[logged] = sensed
-                    ev_i[logged] = order[i]
-                    ev_j[logged] = s
-                    ev_f[logged, 0], ev_f[logged, 1], ev_f[logged, 2], ev_f[logged, 3] = xi, yi, vxi, vyi
-                    ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
-                    if rough:
-                        ev_w[logged, 0], ev_w[logged, 1] = rot[i, W], np.nan
                     logged += 1
-                last_time, last_kind, last_i, last_j = t + epoch, sensed, i, s
+                last_time, last_kind, last_i, last_j = t + epoch, sensed, i, int(seg[other, 5])
             predict(
                 i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
@@ -751,4 +691,4 @@ def run_events(
 
 #: The functions above that call the physics parts (directly or through ``predict``), callees first: the ones
 #: :mod:`~discsim.engines.event_driven.numba.variants` compiles anew.
-PHYSICAL = ("predict", "predict_all", "set_disc", "resense", "run_events")
+PHYSICAL = ("predict", "predict_all", "set_disc", "run_events")

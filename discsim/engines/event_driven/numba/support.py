@@ -4,7 +4,8 @@
 - :func:`restitution`: the coefficient of a collision (one number, the pair of groups', 1 under the TC model);
 - :func:`turn`, :func:`spin_energy`: rough discs' angles and rotational energy;
 - :func:`drag_loss`: the energy drag took from a disc over a flight;
-- :func:`supported`: the discs at rest that a support holds up (they fall again when it goes).
+- :func:`supported`: the discs at rest that a support holds up (they fall again when it goes);
+- :func:`_prefetch_disc`, :func:`_prefetch_cells`: the loop's requests for the memory of its next events.
 
 Compiled into :mod:`discsim.engines.event_driven.numba.loop`'s functions (``inline``) or called by them.
 """
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from discsim._compiled import inline, jit
+from discsim._compiled import inline, jit, prefetch
 from discsim.laws import PER_GROUP, TC, E
 
 __all__ = ["accel", "drag_loss", "restitution", "spin_energy", "supported", "turn"]
@@ -128,3 +129,30 @@ def supported(k, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, fo
                             n += 1
                     j = nxt[j]
     return n
+
+
+@inline
+def _prefetch_disc(c, rec, count, kept_partner, kept_stamp, cell, qt, qk, qo, qs):
+    """Ask for every record of disc ``c`` that an event of it reads (see :func:`discsim._compiled.prefetch`)."""
+    prefetch(rec, c * 8)
+    prefetch(count, c)
+    prefetch(kept_partner, c)
+    prefetch(kept_stamp, c)
+    prefetch(cell, c)
+    prefetch(qt, c)
+    prefetch(qk, c)
+    prefetch(qo, c)
+    prefetch(qs, c)
+
+
+@inline
+def _prefetch_cells(c, head, nx, ny):
+    """Start fetching the heads of the 3 x 3 cells around cell ``c`` (three runs of three in memory)."""
+    cx = c // ny
+    for ddx in range(-1, 2):
+        ox = cx + ddx
+        if ox < 0:
+            ox += nx
+        elif ox >= nx:
+            ox -= nx
+        prefetch(head, ox * ny + c - cx * ny)

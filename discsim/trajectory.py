@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from discsim.errors import InvalidArgumentError, TimeError
-from discsim.events import EventKind, added_discs
+from discsim.events import SENSED, EventKind, added_discs
 from discsim.model import image_steps
 from discsim.physics.dynamics import advance, advance_many
 
@@ -31,6 +31,11 @@ __all__ = [
 
 #: The event kinds after which a disc with velocity exactly zero has come to rest (under gravity).
 _PHYSICAL = (int(EventKind.COLLISION), int(EventKind.WALL))
+
+
+def _second_disc(events: np.ndarray) -> np.ndarray:
+    """``(E,)`` bool: the records whose ``j`` is a disc (a sensor's record names the sensor there)."""
+    return (events["j"] >= 0) & ~np.isin(events["kind"], SENSED)
 
 
 def check_times(times, start: float, end: float, span: str) -> np.ndarray:
@@ -186,7 +191,7 @@ def _sorted_records(events, positions0, velocities0, time0, kinds: bool = False)
         t_recs.append(times)
         seqs.append(np.arange(len(events)))
         states.append(np.column_stack([events["xi"], events["yi"], events["vxi"], events["vyi"]]))
-        pair = np.flatnonzero(events["j"] >= 0)
+        pair = np.flatnonzero(_second_disc(events))
         discs.append(events["j"][pair])  # field by field: gathering whole 89-byte rows is slower
         t_recs.append(times[pair])
         seqs.append(pair)
@@ -300,7 +305,7 @@ class LastRecords:
         m, rows = len(self), np.arange(len(records))
         as_i, as_j = np.full(m, -1), np.full(m, -1)
         np.maximum.at(as_i, records["i"], rows)
-        pair = records["j"] >= 0
+        pair = _second_disc(records)
         np.maximum.at(as_j, records["j"][pair], rows[pair])
         times, positions, velocities = self.times.copy(), self.positions.copy(), self.velocities.copy()
         still = self.still.copy()

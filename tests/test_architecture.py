@@ -11,7 +11,7 @@ from paths import PACKAGE
 #: Floor of each module or package, lowest first (docs/architecture.md).
 FLOORS = {
     "ground": ["model", "queue", "errors", "_validate", "_interrupt", "_numba", "_compiled", "_progress", "_version"],
-    "model": ["scene", "laws", "events", "cells", "repair", "spatial"],
+    "model": ["scene", "laws", "events", "cells", "repair", "spatial", "sensors"],
     "physics": ["physics", "kernels", "trajectory", "losses"],
     "engines": ["engines"],
     "top": ["run", "io", "analysis", "cli", "plot", "view", "scenarios", "__init__", "__main__"],

@@ -80,6 +80,11 @@ class FrameSensors:
     def __init__(self, sensors: tuple[Sensor, ...], box: Box):
         self.sensors = sensors
         self.box = box
+        # The sensors inside the box: a step that stays in it reaches none of their images.
+        self._inside = [
+            box.periodic and x0 >= 0.0 and y0 >= 0.0 and x1 < box.width and y1 < box.height
+            for x0, y0, x1, y1 in (sensor.bounds() for sensor in sensors)
+        ]
 
     def look(self, paths: Paths, frame_time: float) -> tuple[np.ndarray, np.ndarray | None]:
         """What :meth:`records` needs of the last frame, at ``frame_time``, before the next changes ``paths``:
@@ -114,7 +119,7 @@ class FrameSensors:
         discs, sensors, kinds = [], [], []
         for k, sensor in enumerate(self.sensors):
             if sensor.code == LINE:
-                rows, entered = self._line(sensor, before, end)
+                rows, entered = self._line(sensor, before, end, images=end is not after or not self._inside[k])
             else:
                 now = sensor.contains(after)
                 rows = np.flatnonzero(sensor.contains(before) != now)
@@ -136,35 +141,32 @@ class FrameSensors:
             out[name] = _NAN
         return out
 
-    def _line(self, sensor: Sensor, before: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _line(self, sensor: Sensor, before: np.ndarray, end: np.ndarray, images: bool) -> tuple[np.ndarray, np.ndarray]:
         """``(discs, entered)``: the discs whose step from ``before`` to ``end`` crosses ``sensor`` (a line), one
-        row per image of the line crossed in a periodic box, and whether each ended on its left."""
-        if not self.box.periodic:
-            rows = np.flatnonzero(sensor.crossed(before, end))
-            return rows, sensor.contains(end[rows])
-        # The images m (whole boxes) of the line that the step's bounding box reaches, per axis.
-        size = self.box.size
-        x0, y0, x1, y1 = sensor.bounds()
-        low, high = np.minimum(before, end), np.maximum(before, end)
-        first = np.ceil((low - np.array([x1, y1])) / size).astype(np.int64)
-        last = np.floor((high - np.array([x0, y0])) / size).astype(np.int64)
-        near = np.flatnonzero((first <= last).all(axis=1))
-        hits: list[np.ndarray] = []
-        entered: list[np.ndarray] = []
-        if len(near):
-            f, la = first[near], last[near]
-            for mx in range(int(f[:, 0].min()), int(la[:, 0].max()) + 1):
-                for my in range(int(f[:, 1].min()), int(la[:, 1].max()) + 1):
-                    at = near[(f[:, 0] <= mx) & (mx <= la[:, 0]) & (f[:, 1] <= my) & (my <= la[:, 1])]
-                    if not len(at):
-                        continue
-                    shift = np.array([mx, my]) * size  # the step moved back by the image's offset
-                    p, q = before[at] - shift, end[at] - shift
-                    hit = sensor.crossed(p, q)
-                    hits.append(at[hit])
-                    entered.append(sensor.contains(q[hit]))
-        if not hits:
-            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool)
+        row per image of the line crossed in a periodic box (``images``: some step may reach another image than
+        the line's own), and whether each ended on its left."""
+        # The line itself first, for every disc: in a periodic box most steps reach no other image.
+        rows = np.flatnonzero(sensor.crossed(before, end))
+        hits, entered = [rows], [sensor.contains(end[rows])]
+        if self.box.periodic and images:
+            # The images m (whole boxes) of the line that the step's bounding box reaches, per axis; a disc whose
+            # step reaches another image than the line's own is tested against each (few discs, few images).
+            size = self.box.size
+            x0, y0, x1, y1 = sensor.bounds()
+            low, high = np.minimum(before, end), np.maximum(before, end)
+            first = np.ceil((low - np.array([x1, y1])) / size).astype(np.int64)
+            last = np.floor((high - np.array([x0, y0])) / size).astype(np.int64)
+            odd = np.flatnonzero((first <= last).all(axis=1) & ((first != 0) | (last != 0)).any(axis=1))
+            for d in odd.tolist():
+                for mx in range(int(first[d, 0]), int(last[d, 0]) + 1):
+                    for my in range(int(first[d, 1]), int(last[d, 1]) + 1):
+                        if mx == 0 and my == 0:
+                            continue  # tested above
+                        shift = np.array([mx, my]) * size  # the step moved back by the image's offset
+                        p, q = before[d : d + 1] - shift, end[d : d + 1] - shift
+                        if sensor.crossed(p, q)[0]:
+                            hits.append(np.array([d]))
+                            entered.append(sensor.contains(q))
         return np.concatenate(hits), np.concatenate(entered)
 
 

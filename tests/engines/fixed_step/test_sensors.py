@@ -231,6 +231,27 @@ def test_sensor_records_name_discs_by_id_after_a_removal():
     assert rows(sim) == [(1.25, ENTER, 1, 0), (1.25, ENTER, 2, 0)]
 
 
+def test_a_disc_moved_by_set_positions_counts_as_having_been_there_at_the_frame():
+    # FixedStep takes a disc set somewhere as having been there at the last frame (its frame position): set into
+    # a circle, it logs nothing until it leaves (as a disc that starts or is added inside one).
+    pocket = Sensor.circle((5.0, 5.0), 1.0)
+    sim = ds.FixedStep(lone(1.0, 5.0, 0.0, 1.0), ds.Box(10.0, 10.0), dt=DT, sensors=[pocket]).run(until=0.6)
+    sim.set_positions([0], [[5.0, 5.0]])
+    sim.run(until=2.0)
+    assert rows(sim) == [(1.75, LEAVE, 0, 0)]  # y = 5 + (t - 0.6) reaches 6 at t = 1.6
+
+
+def test_a_velocity_set_between_frames_in_a_periodic_box_keeps_the_line_step_straight():
+    # Set moving +x at t = 0.1 from x = 9.7 (it was still since the frame at 0); at the frame 0.25 it is at
+    # 10.0 wrapped to 0.0, having crossed the wire at x = 9.9 (and not the one across the middle).
+    box = ds.Box(10.0, 10.0, periodic=True)
+    wires = [Sensor.line((9.9, 0.0), (9.9, 10.0)), Sensor.line((5.0, 0.0), (5.0, 10.0))]
+    sim = ds.FixedStep(lone(9.7, 5.0, 0.0, 0.0), box, dt=DT, sensors=wires).run(until=0.1)
+    sim.set_velocities([0], [[2.0, 0.0]])
+    sim.run(until=0.25)
+    assert rows(sim) == [(0.25, LEAVE, 0, 0)]
+
+
 def test_the_trajectory_is_unchanged_by_sensor_records():
     plain = ds.FixedStep(*ds.random_gas(10, 0.2, periodic=False, seed=3), dt=0.05).run(until=3.0)
     watched = ds.FixedStep(

@@ -242,7 +242,9 @@ class Tally:
         log (EventLog or None): where responses are logged (None: not recorded).
     """
 
-    NAMES = ("frames", "pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits", "list_builds")
+    NAMES = (
+        "frames", "pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits", "list_builds", "sensed"
+    )  # fmt: skip
 
     def __init__(
         self, counts: dict[str, int] | None = None, max_overlap: float = 0.0, virial: float = 0.0,

@@ -47,14 +47,16 @@ from discsim.engines.fixed_step.broad_phase import BROAD_PHASE_CLASSES
 from discsim.engines.fixed_step.frame import FRAME_POLICY_CLASSES
 from discsim.engines.fixed_step.readout import FrameReadout
 from discsim.engines.fixed_step.run_state import FixedStepRun
+from discsim.engines.fixed_step.sensing import FrameSensing
 from discsim.engines.fixed_step.state import FixedStepState
 from discsim.engines.fixed_step.sub_frame import SUB_FRAME_POLICY_CLASSES, Bisect
 from discsim.engines.record import collision_virials
 from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
 from discsim.laws import Laws
-from discsim.model import Box, Discs, frame_count
+from discsim.model import Box, Discs
 from discsim.scene import Scene
+from discsim.sensors import Sensor, check_sensors
 
 __all__ = ["BACKENDS", "BROAD_PHASES", "COMPILED_POLICIES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
 
@@ -86,7 +88,7 @@ def _fixed_segments(scene: Scene) -> Scene:
 
 
 @register_engine
-class FixedStep(FrameReadout, FixedStepRun, Engine):
+class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
     """Fixed-step simulation with a periodic interference test (PIT).
 
     Args:
@@ -130,6 +132,10 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             ``EventDriven``: over a frame and between frames each disc of finite mass follows the exact exponential
             flight (velocity ``v e^(-gamma t) + g tau(t)``, ``tau = (1 - e^(-gamma t)) / gamma``; the frame
             policies only: ``"bisect"`` and ``"swept"`` refuse it); what it takes counts in :attr:`dissipated`.
+        sensors: :class:`~discsim.sensors.Sensor` regions and trip wires (default none), seen at the frames: one
+            ``"enter"`` or ``"leave"`` record (``j`` the sensor's index) per change since the last frame, at the
+            frame's time (:mod:`~discsim.engines.fixed_step.sensing`); one passed clean through between two frames
+            is not seen.
 
     Raises:
         InvalidArgumentError: on a frame rate, ``dt`` or ``bisect_tol`` that is
@@ -137,7 +143,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             ``drag`` too), gravity or drag with a sub-frame policy, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
             a periodic box, ``backend="numba"`` without numba (naming the extra to
-            install).
+            install), ``sensors`` not a list of :class:`~discsim.sensors.Sensor` (naming the item).
         TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
         InvalidDiscsError: on a malformed ``pass_through``.
         OutsideBoxError, OverlapError: if the discs do not fit in the box (or
@@ -157,7 +163,8 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             spent by ``"bisect"``, one at the start of each interval and one
             per halving); ``detections`` (pairs that got an impulse);
             ``wall_hits`` (discs reflected by a wall or a segment);
-            ``list_builds`` (rebuilds of the grid's Verlet list).
+            ``list_builds`` (rebuilds of the grid's Verlet list); ``sensed`` (sensor records).
+        sensors (tuple): the :class:`~discsim.sensors.Sensor` objects (empty: none).
         max_overlap (float): deepest disc-disc overlap seen, as a fraction of
             the pair's contact distance (0 if discs never overlapped): at the
             frames for the first three policies; on the path kept (at contacts
@@ -204,6 +211,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         rest_speed: float | None = None,
         roughness: float = -1.0,
         drag: float = 0.0,
+        sensors=None,
     ):
         if dt is None:
             rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
@@ -224,13 +232,14 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             raise InvalidArgumentError(msg)
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
-        backend = _choose_backend(backend, policy)
-        scene = _fixed_segments(Scene(discs, box, segments, pass_through))
-        self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws.checked(scene))
+        backend, sensors = _choose_backend(backend, policy), check_sensors(sensors)
+        scene = _fixed_segments(Scene(discs, box, segments, pass_through, sensors=sensors))
+        laws = laws.checked(scene)
+        self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws, sensors)
         self._load(self._initial_state())
 
     def _configure(
-        self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend, laws
+        self, scene, record, frame_rate, dt, by_rate, policy, broad_phase, bisect_tol, backend, laws, sensors=()
     ) -> None:
         """Build the parts the options choose (checked already; ``backend`` resolved); the run state comes
         from :meth:`_load`.
@@ -244,6 +253,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         self.broad_phase = broad_phase
         self.bisect_tol = bisect_tol
         self.backend = backend
+        self._watch(sensors, scene.box)
         self._shapes, self._broad, self._policy = self._parts(scene)
 
     def _parts(self, scene: Scene) -> tuple:
@@ -285,6 +295,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             "backend": self.backend,
             "edits": self._edits,
             **({} if self.laws.default and self.laws.tc == 0.0 else {"laws": self.laws.settings()}),
+            **self._sensor_settings(),
         }
 
     @classmethod
@@ -308,6 +319,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             float(settings["bisect_tol"]),
             backend,
             _restored_laws(settings),
+            _restored_sensors(settings),
         )
         sim.start_time = start_time
         sim._edits = int(settings.get("edits", 0))
@@ -328,7 +340,8 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             msg = "a fixed-step run needs a finite until or a frame count"
             raise InvalidArgumentError(msg)
         done = 0
-        batch = getattr(self._policy, "batch", 1)  # frames per call: the compiled frame does many at once
+        # Frames per call: the compiled frame does many at once (one with sensors: they look at every frame).
+        batch = getattr(self._policy, "batch", 1) if self._sensing is None else 1
         if callable(batch):  # as many as the policy can vouch for without a check before each frame
             batch = batch(self._paths, self.dt)
         while done < todo:
@@ -343,25 +356,10 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
                     done += count
         return todo
 
-    def _frames_due(self, until: float) -> int | None:
-        """Frames still to do up to time ``until``, allowing for the roundoff of ``k * dt``; None (no count) for
-        ``until = inf``.
-
-        Counted from the start, so that a run gives the same frames however it is cut into calls.
-        """
-        if until == math.inf:
-            return None
-        last = frame_count(self.start_time, until, self.dt)
-        return max(0, last - self.frames)
-
-    def _units(self) -> int:
-        """Frames done since the start."""
-        return self.frames
-
     def _event_count(self) -> int:
-        """Log records produced since the start: one per detection and one per wall or segment hit."""
+        """Log records produced since the start: one per detection, wall or segment hit, edit and sensor crossing."""
         counts = self._tally.counts
-        return counts["detections"] + counts["wall_hits"] + self._edits
+        return counts["detections"] + counts["wall_hits"] + self._edits + counts["sensed"]
 
     def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
         paths, t = self._paths, self.time
@@ -437,7 +435,8 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
             empty if nothing touched: for ``"resolve"``, ``"revert"`` and
             ``"separate"`` wall hits first, then segment hits, then disc pairs
             in the order they were handled, all at the frame time; for
-            ``"bisect"`` and ``"swept"`` in the order of their contact times.
+            ``"bisect"`` and ``"swept"`` in the order of their contact times; then the sensors' ``"enter"``
+            and ``"leave"`` at the frame, by disc then sensor.
 
         Example:
             >>> import discsim as ds
@@ -456,6 +455,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         k = tally.counts["frames"] + 1
         t = self.frame_time(k)
         tally.log = self._log if self._logging else None
+        last = None if self._sensing is None else self._sensing.look(paths, self._frame_time)  # the last frame
         try:
             events = self._policy.frame(paths, tally, self._frame_time, t)
         except Interrupted:  # raised only between frames (deferred_interrupt): the state is consistent
@@ -466,7 +466,7 @@ class FixedStep(FrameReadout, FixedStepRun, Engine):
         self._frame_time = t
         self.time = t
         tally.counts["frames"] = k
-        return events
+        return events if last is None else events + self._sensed(last, t)
 
     def _frames(self, count: int) -> None:
         """Do ``count`` frames in one call of the compiled frame (the same frames as ``count`` calls of
@@ -498,6 +498,30 @@ def _restored_laws(settings: dict) -> Laws:
     except InvalidArgumentError as exc:
         msg = f"the checkpoint's laws cannot be used: {exc}"
         raise CheckpointError(msg) from exc
+
+
+def _restored_sensors(settings: dict) -> tuple[Sensor, ...]:
+    """The sensors a checkpoint's settings hold (none: none), built and checked as the constructor's.
+
+    Raises:
+        CheckpointError: naming the entry that cannot be a sensor.
+    """
+    sensors = []
+    for k, entry in enumerate(settings.get("sensors", [])):
+        try:
+            shape, a = entry[0], [float(x) for x in entry[1:]]
+            if len(a) != 4:
+                raise ValueError("a shape and 4 numbers expected")
+            if shape == "circle":
+                sensors.append(Sensor.circle(a[:2], a[2]))
+            elif shape in ("rectangle", "line"):
+                sensors.append(getattr(Sensor, shape)(a[:2], a[2:]))
+            else:
+                raise ValueError(f"unknown shape {shape!r}")
+        except (TypeError, ValueError, IndexError, InvalidArgumentError) as exc:
+            msg = f"the checkpoint's sensors[{k}] cannot be used: {entry!r} ({exc})"
+            raise CheckpointError(msg) from None
+    return tuple(sensors)
 
 
 def _check_laws(laws: Laws, policy: str) -> Laws:

@@ -1,5 +1,5 @@
 """What a fixed-step run shows: positions and velocities at any time, spins and angles, the counters, the pressure,
-the energies, the trajectory under gravity, the frame clock.
+the energies, the trajectory under gravity, the frame clock (and the frames still due).
 
 :class:`FrameReadout` is the read-only side of :class:`~discsim.engines.fixed_step.engine.FixedStep`: it reads
 the paths (:class:`~discsim.engines.fixed_step.arrays.Paths`) between frames and changes nothing.
@@ -14,8 +14,9 @@ import numpy as np
 
 from discsim.engines.fixed_step.arrays import Paths, Shapes, Tally
 from discsim.errors import InvalidArgumentError
+from discsim.events import SENSED
 from discsim.laws import Laws
-from discsim.model import Box, Discs, _readonly, kinetic_energy, rotational_energy
+from discsim.model import Box, Discs, _readonly, frame_count, kinetic_energy, rotational_energy
 from discsim.physics.damped import spans_many
 
 __all__ = ["FrameReadout"]
@@ -207,7 +208,8 @@ class FrameReadout:
         events = self.events
         g, drag = np.array(self.laws.gravity), self.laws.drag
         for d in np.flatnonzero(falls).tolist():
-            records = events["time"][(events["i"] == d) | (events["j"] == d)]  # in time order
+            # In time order; a sensor's record names the sensor in j, not a disc.
+            records = events["time"][(events["i"] == d) | ((events["j"] == d) & ~np.isin(events["kind"], SENSED))]
             last = np.concatenate([[self.start_time], records])[np.searchsorted(records, asked, side="right")]
             since = asked - last
             fall = spans_many(since, drag)[1] if drag != 0.0 else 0.5 * (since * since)
@@ -220,6 +222,21 @@ class FrameReadout:
         """None: the log's trajectory is rebuilt in free flight, and :meth:`trajectory` adds the fall (a PIT run
         has no rest, so the event-driven rule "a record of zero velocity rests" must not apply)."""
         return None
+
+    def _frames_due(self, until: float) -> int | None:
+        """Frames still to do up to time ``until``, allowing for the roundoff of ``k * dt``; None (no count) for
+        ``until = inf``.
+
+        Counted from the start, so that a run gives the same frames however it is cut into calls.
+        """
+        if until == math.inf:
+            return None
+        last = frame_count(self.start_time, until, self.dt)
+        return max(0, last - self.frames)
+
+    def _units(self) -> int:
+        """Frames done since the start."""
+        return self.frames
 
     def frame_time(self, k):
         """The time of frame ``k`` (frame 0 is the start); ``k`` may be an int array."""

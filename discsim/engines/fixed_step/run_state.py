@@ -89,6 +89,7 @@ class FixedStepRun:
             last_collision=paths.last_collision.copy(),
             spins=spins,
             angles=angles,
+            sensed=counts["sensed"],
         )
 
     def _load(self, state: FixedStepState) -> None:

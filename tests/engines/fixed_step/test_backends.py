@@ -17,6 +17,8 @@ import pytest
 import discsim as ds
 from discsim import _numba
 from discsim.engines.fixed_step.engine import COMPILED_POLICIES, SUB_FRAME_POLICIES
+from discsim.events import SENSED
+from discsim.sensors import Sensor
 
 #: The policies that answer at the frame (the rest answer inside it).
 FRAME_POLICIES = tuple(p for p in COMPILED_POLICIES if p not in SUB_FRAME_POLICIES)
@@ -441,3 +443,19 @@ def test_importing_discsim_does_not_load_the_compiled_frame():
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"
+
+
+@needs_numba
+@pytest.mark.parametrize("policy", COMPILED_POLICIES)
+@pytest.mark.parametrize("periodic", [True, False])
+def test_both_backends_report_the_same_sensor_records(policy, periodic):
+    discs, box = ds.random_gas(40, 0.25, periodic=periodic, seed=11, temperature=4.0)
+    w = box.width
+    # Sensors at the frames (issue 28): the records come from the frames both backends share.
+    sensors = [Sensor.circle((0.5 * w, 0.5 * w), 0.2 * w), Sensor.line((0.05 * w, 0.6 * w), (0.95 * w, 0.55 * w))]
+    runs = [
+        ds.FixedStep(discs, box, dt=0.05, policy=policy, sensors=sensors, backend=backend).run(frames=80)
+        for backend in ("python", "numba")
+    ]
+    assert np.isin(runs[0].events["kind"], SENSED).sum() > 10
+    assert runs[0].events.tobytes() == runs[1].events.tobytes() and runs[0].counts == runs[1].counts

@@ -1,13 +1,13 @@
 """Pictures of discs, paths, PIT-against-PIC cases and animations (matplotlib).
 
-The only module of discsim that imports matplotlib. Every function reads the
-engine protocol (``discs``, ``box``, ``time``, ``positions``, ``velocities``,
-``events``, ``trajectory``), so it draws any engine; it uses ``dt`` (the frame
-interval) when an engine has one. Each returns the matplotlib object it made or
-drew on; with ``ax=None`` it makes a new figure.
+The only module of discsim that imports matplotlib (with its part ``discsim._plot_sensors``). Every function
+reads the engine protocol (``discs``, ``box``, ``time``, ``positions``, ``velocities``, ``events``,
+``trajectory``), so it draws any engine; it uses ``dt`` (the frame interval) when an engine has one. Each returns
+the matplotlib object it made or drew on; with ``ax=None`` it makes a new figure.
 
 Lengths are drawn to scale: discs are circles of their true radii and the
 axes have equal aspect.
+An engine's sensors (``sim.sensors``) are drawn under the discs, as the viewer draws them.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
+from discsim._plot_sensors import draw_sensors
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, COLLISION
 from discsim.model import Discs, frame_count
@@ -53,7 +54,8 @@ def _axes(ax, figsize=(6.0, 4.5)):
     return ax
 
 
-def _setup(ax, box) -> None:
+def _setup(ax, box, sensors=()) -> None:
+    draw_sensors(ax, sensors, box)
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
@@ -134,7 +136,7 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True, marks: b
         quiver = _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
         if quiver is not None and box is not None:  # arrows end at the walls, as the discs do
             quiver.set_clip_path(Rectangle((0.0, 0.0), box.width, box.height, transform=ax.transData))
-    _setup(ax, box)
+    _setup(ax, box, getattr(sim_or_discs, "sensors", ()))
     if box is None and len(positions):
         r = float(discs.radii.max())
         ax.set_xlim(positions[:, 0].min() - 2 * r, positions[:, 0].max() + 2 * r)
@@ -203,7 +205,7 @@ def plot_trajectories(sim, ax=None, discs=None, *, samples: int = 400):
     starts = paths[0, chosen]
     ax.scatter(starts[:, 0], starts[:, 1], s=8, c=[colours[i] for i in chosen.tolist()], zorder=3)
     _circles(ax, paths[-1, chosen], sim.discs.radii[chosen], [colours[i] for i in chosen.tolist()], fill=False)
-    _setup(ax, sim.box)
+    _setup(ax, sim.box, getattr(sim, "sensors", ()))
     ax.set_title(f"{type(sim).__name__}: paths over t in [{times[0]:.3g}, {times[-1]:.3g}]")
     return ax
 
@@ -308,7 +310,7 @@ def _draw_case_panel(ax, sim, truth, frames, times, arrow_time, contact_style, t
         vel = np.concatenate([np.column_stack([own["vxi"], own["vyi"]]), np.column_stack([own["vxj"], own["vyj"]])])
         who = np.concatenate([own["i"], own["j"]]).tolist()
         _arrows(ax, pos, vel, arrow_time, [colours[d] for d in who])
-    _setup(ax, sim.box)
+    _setup(ax, sim.box, getattr(sim, "sensors", ()))
     ax.set_xlim(limits[0], limits[1])
     ax.set_ylim(limits[2], limits[3])
     ax.set_title(title, fontsize=10)
@@ -594,7 +596,7 @@ def animate(
         if len(sims) > 1:
             for truth in truths:
                 outlines += _contact_outlines(ax, truth, colours, "-" if truth is s else "--")
-        _setup(ax, s.box)
+        _setup(ax, s.box, getattr(s, "sensors", ()))
         ax.set_xlim(limits[0], limits[1])
         ax.set_ylim(limits[2], limits[3])
         ax.set_title(type(s).__name__, fontsize=10, loc="left")

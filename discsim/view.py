@@ -8,10 +8,14 @@ rest stays put), so the page rebuilds every position exactly as :func:`discsim.t
 with the same floating-point operations (the same numbers, bit for bit): it holds the discs' state where the
 replay starts and each disc's state after each of its events. Where the run says how its discs turn (an
 engine's spins, rough discs' spins after each collision), a radius line on each disc shows its angle.
+The run's sensors (:class:`~discsim.sensors.Sensor`) are drawn under the discs: circles and rectangles as translucent
+outlined regions, trip wires dashed with a small arrow to their inside (the left of ``p1 - p0``); a sensor lights up
+for 0.3 s of playing after a disc enters it.
 
 In the page, ``window.discsim`` is a small API for scripts and tests: ``seek(t)``, ``time()``,
 ``positions(panel)`` (the centres last drawn, ``(N, 2)`` as nested lists), ``angles(panel)`` (the angles of
-the marks last drawn, ``(N,)``, or null where the run does not say how its discs turn), ``play()``, ``pause()``,
+the marks last drawn, ``(N,)``, or null where the run does not say how its discs turn), ``sensors(panel)`` (each
+sensor's ``shape``, ``params`` and whether it is ``lit`` at the time last drawn), ``play()``, ``pause()``,
 ``step(frames)``, ``nextEvent()``, ``previousEvent()``, ``setSpeed(s)``, ``setFps(f)``, ``setColour(mode)``.
 A page opened as ``view.html#t=1.25`` starts at that time.
 
@@ -37,7 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from discsim.errors import InvalidArgumentError
-from discsim.events import ADD, COLLISION, EVENT_DTYPE, EventKind, disc_count, disc_partners
+from discsim.events import ADD, COLLISION, ENTER, EVENT_DTYPE, EventKind, disc_count, disc_partners
 from discsim.trajectory import LastRecords, falling, flight, turning_history
 
 if TYPE_CHECKING:
@@ -75,6 +79,7 @@ class _Run:
     dt: float | None
     gravity: tuple[float, float] | None = None
     turning: tuple | None = None  # a turning_history of the discs by id, or None: the page draws no marks
+    sensors: tuple = ()  # the run's Sensors, drawn as regions and trip wires
 
 
 @dataclass(frozen=True)
@@ -118,7 +123,12 @@ def _from_engine(sim, label: str | None) -> _Run:
     stream = None if context is None else context.stream
     if stream is not None:  # the run streamed its log to disk: replay the file, with the engine's scene
         return _from_log_file(
-            Path(stream["path"]), label or name, name, getattr(sim, "segments", ()), getattr(sim, "dt", None)
+            Path(stream["path"]),
+            label or name,
+            name,
+            getattr(sim, "segments", ()),
+            getattr(sim, "dt", None),
+            tuple(getattr(sim, "sensors", ())),
         )
     if not getattr(sim, "record", True):
         msg = (
@@ -145,6 +155,7 @@ def _from_engine(sim, label: str | None) -> _Run:
         dt=float(dt) if dt else None,
         gravity=gravity,
         turning=turning,
+        sensors=tuple(getattr(sim, "sensors", ())),
     )
 
 
@@ -163,11 +174,15 @@ def _from_stream(log, label: str, engine: str = "EventDriven", segments=(), dt=N
         chunks=lambda: iter([events]),
         dt=dt,
         gravity=gravity,
+        sensors=tuple(getattr(log, "sensors", ())),
     )
 
 
-def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
-    """A run from a streamed log on disk, read chunk by chunk when the page is made (never whole)."""
+def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments=(), dt=None, sensors=()) -> _Run:
+    """A run from a streamed log on disk, read chunk by chunk when the page is made (never whole).
+
+    ``sensors`` (an engine's, or a checkpoint's scene): the run's sensors; none given, those of the log's header.
+    """
     from discsim.io.container import stream_index
     from discsim.io.streams import iter_events
 
@@ -185,19 +200,22 @@ def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments
         chunks=log.record_arrays,
         dt=dt,
         gravity=gravity,
+        sensors=tuple(sensors) or log.sensors,
     )
 
 
 def _checkpoint_scene(path: Path):
-    """``(engine name, segments, dt)`` stored in a checkpoint, without building the engine."""
+    """``(engine name, segments, dt, sensors)`` stored in a checkpoint, without building the engine."""
     from discsim.io.container import read_state
+    from discsim.io.streams import sensors_from_rows
     from discsim.model import Segment
 
     meta, _ = read_state(path)
-    ends = (meta.get("scene") or {}).get("segments") or []
-    segments = [Segment(s[:2], s[2:]) for s in ends]
+    scene = meta.get("scene") or {}
+    segments = [Segment(s[:2], s[2:]) for s in scene.get("segments") or []]
+    sensors = sensors_from_rows(scene.get("sensors"), path)
     dt = (meta.get("settings") or {}).get("dt")
-    return str(meta.get("engine", "EventDriven")), segments, (float(dt) if dt else None)
+    return str(meta.get("engine", "EventDriven")), segments, (float(dt) if dt else None), sensors
 
 
 def _from_path(path: Path, label: str | None) -> _Run:
@@ -217,8 +235,8 @@ def _from_path(path: Path, label: str | None) -> _Run:
                 f"checkpoint ({RUN_FOLDER_FILES[1]}); a run folder is written by `discsim run --out FOLDER`"
             )
             raise InvalidArgumentError(msg)
-        engine, segments, dt = _checkpoint_scene(checkpoint) if checkpoint.exists() else ("EventDriven", (), None)
-        return _from_log_file(events_file, label or path.name, engine, segments, dt)
+        scene = _checkpoint_scene(checkpoint) if checkpoint.exists() else ("EventDriven", (), None, ())
+        return _from_log_file(events_file, label or path.name, *scene)
     with path.open("rb") as handle:
         is_state = handle.read(len(STATE_MAGIC)) == STATE_MAGIC
     if not is_state:  # an event log (read_events names what else it may be)
@@ -229,8 +247,8 @@ def _from_path(path: Path, label: str | None) -> _Run:
         log_path = Path(stream["path"])
         if not log_path.is_absolute() and not log_path.exists():
             log_path = path.parent / log_path.name
-        _, segments, dt = _checkpoint_scene(path)
-        return _from_log_file(log_path, label or path.name, type(sim).__name__, segments, dt)
+        _, segments, dt, sensors = _checkpoint_scene(path)
+        return _from_log_file(log_path, label or path.name, type(sim).__name__, segments, dt, sensors)
     return _from_engine(sim, label or path.name)
 
 
@@ -381,6 +399,7 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
     box = run.box
     ev = span.events
     contacts = ev[(ev["kind"] == COLLISION) & (ev["time"] >= t0) & (ev["time"] <= t1)]
+    entries = ev[(ev["kind"] == ENTER) & (ev["time"] >= t0) & (ev["time"] <= t1)]  # j: the sensor
     speeds = np.hypot(states[:, 2], states[:, 3])
     speeds = speeds[np.isfinite(speeds)]
     return {
@@ -391,6 +410,9 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
         "n": len(discs),
         "box": {"width": float(box.width), "height": float(box.height), "periodic": bool(box.periodic)},
         "segments": [[*map(float, s.p0), *map(float, s.p1)] for s in run.segments],
+        "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in run.sensors],  # as checkpoints store them
+        "enter_times": _b64(entries["time"], "<f8"),
+        "enter_sensors": _b64(entries["j"], "<i4"),
         "radii": _b64(np.nan_to_num(discs.radii), "<f8"),
         "fixed": _b64(np.isinf(discs.masses), "u1"),
         "groups": _b64(discs.groups, "<i4"),

@@ -264,3 +264,59 @@ def test_animate_follows_discs_that_come_and_go():
     # Each circle has its disc's size: the added one (id 12) its radius 0.5 (get_widths: full widths).
     np.testing.assert_allclose(collection.get_widths(), 2.0 * np.append(discs.radii, 0.5))
     plot.close(anim)
+
+
+def sensed_run():
+    discs, box = ds.random_gas(20, 0.2, seed=5)
+    w, h = box.width, box.height
+    sensors = [
+        ds.Sensor.circle((0.3 * w, 0.3 * h), 0.15 * w),
+        ds.Sensor.rectangle((0.6 * w, 0.1 * h), (0.9 * w, 0.4 * h)),
+        ds.Sensor.line((0.1 * w, 0.7 * h), (0.9 * w, 0.7 * h)),
+    ]
+    return ds.EventDriven(discs, box, sensors=sensors).run(until=0.5), sensors
+
+
+def sensor_artists(ax) -> dict:
+    """The artists a plot tagged as sensors, by gid (``sensor k``, and ``sensor k inside`` for a wire's arrow)."""
+    found: dict = {}
+    for artist in ax.get_children():
+        gid = artist.get_gid() or ""
+        if gid.startswith("sensor"):
+            assert gid not in found, f"two artists for {gid}"
+            found[gid] = artist
+    return found
+
+
+def assert_draws_sensors(ax, sensors):
+    from matplotlib.patches import Rectangle
+    from matplotlib.text import Annotation
+
+    artists = sensor_artists(ax)
+    assert sorted(artists) == ["sensor 0", "sensor 1", "sensor 2", "sensor 2 inside"]  # one each, and one arrow
+    circle, rectangle, wire, arrow = (artists[k] for k in sorted(artists))
+    (cx, cy, r, _), (x0, y0, x1, y1), (p0x, p0y, p1x, p1y) = (s.params.tolist() for s in sensors)
+    assert isinstance(circle, Circle) and circle.center == (cx, cy) and circle.radius == r
+    assert circle.get_facecolor()[3] < 0.5  # translucent
+    assert isinstance(rectangle, Rectangle) and rectangle.get_xy() == (x0, y0)
+    assert (rectangle.get_width(), rectangle.get_height()) == (x1 - x0, y1 - y0)
+    assert wire.get_xydata().tolist() == [[p0x, p0y], [p1x, p1y]] and wire.get_linestyle() == "--"
+    # The arrow starts on the wire and points to its inside, the left of p1 - p0.
+    assert isinstance(arrow, Annotation)
+    (tx, ty), (sx, sy) = arrow.xy, arrow.xyann
+    assert sensors[2].contains([tx, ty])[0]  # the tip lies inside
+    assert abs((p1x - p0x) * (sy - p0y) - (p1y - p0y) * (sx - p0x)) < 1e-9  # the tail lies on the wire
+
+
+def test_the_plots_draw_each_sensor_once(tmp_path):
+    sim, sensors = sensed_run()
+    assert_draws_sensors(plot.plot_state(sim), sensors)
+    assert_draws_sensors(plot.plot_trajectories(sim), sensors)
+    pit = ds.FixedStep(sim.discs, sim.box, frame_rate=20.0).run(until=0.5)
+    _, pic_ax = plot.plot_case(sim, pit).axes[:2]
+    assert_draws_sensors(pic_ax, sensors)
+    anim = plot.animate(sim, zoom=False)
+    assert_draws_sensors(anim._fig.axes[0], sensors)
+    plot.close(anim)
+    assert not sensor_artists(plot.plot_state(ds.EventDriven(*ds.random_gas(5, 0.2)).run(until=0.1)))
+    assert_not_blank(plot.save_figure(plot.plot_state(sim), tmp_path / "sensors.png"))

@@ -477,3 +477,126 @@ def test_a_log_streamed_from_mid_run_draws_the_discs_at_rest_where_they_rest(tmp
     expected = ds.EventDriven(discs, ds.Box(10, 10), **laws).run(until=4.0).trajectory(times)
     for k, r in enumerate(seek_all(page.path, tmp_path, times)):
         assert_same_positions(r["positions"][0], expected[k])
+
+
+# --- sensors ---------------------------------------------------------------------------------------------
+
+
+def sensed_gas(**kwargs):
+    """A gas with a circle, a rectangle and a trip wire, and the sensors (discs enter each within t = 2)."""
+    discs, box = ds.random_gas(20, 0.2, seed=5)
+    w, h = box.width, box.height
+    sensors = [
+        ds.Sensor.circle((0.3 * w, 0.3 * h), 0.15 * w),
+        ds.Sensor.rectangle((0.6 * w, 0.1 * h), (0.9 * w, 0.4 * h)),
+        ds.Sensor.line((0.1 * w, 0.7 * h), (0.9 * w, 0.7 * h)),
+    ]
+    return ds.EventDriven(discs, box, sensors=sensors, **kwargs), sensors
+
+
+def sensor_rows(sensors) -> list[list[float]]:
+    return [[s.code, *s.params.tolist()] for s in sensors]
+
+
+def test_the_page_gets_the_sensors_of_a_live_run_and_when_discs_enter_them():
+    sim, sensors = sensed_gas()
+    sim.run(until=2.0)
+    (run,) = page_data(ds.view(sim, path=None))["runs"]
+    assert run["sensors"] == sensor_rows(sensors)
+    entered = sim.events[sim.events["kind"] == ds.events.ENTER]
+    assert len(entered) >= 2
+    times = np.frombuffer(base64.b64decode(run["enter_times"]), dtype="<f8")
+    which = np.frombuffer(base64.b64decode(run["enter_sensors"]), dtype="<i4")
+    assert times.tolist() == entered["time"].tolist() and which.tolist() == entered["j"].tolist()
+    # A window that starts later holds only the entries in it; a run without sensors has none.
+    (late,) = page_data(ds.view(sim, path=None, start=1.0))["runs"]
+    late_times = np.frombuffer(base64.b64decode(late["enter_times"]), dtype="<f8")
+    assert late_times.tolist() == entered["time"][entered["time"] >= 1.0].tolist()
+    (plain,) = page_data(ds.view(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5), path=None))["runs"]
+    assert plain["sensors"] == [] and plain["enter_times"] == ""
+
+
+def test_the_sensors_come_back_from_a_stream_a_run_folder_and_a_checkpoint(tmp_path):
+    folder = tmp_path / "run"
+    folder.mkdir()
+    streamed, sensors = sensed_gas(record=False)
+    streamed.run(until=2.0, record_to=folder / "events.dse")
+    streamed.save(folder / "state.dsc")
+    in_memory, _ = sensed_gas()
+    in_memory.run(until=2.0).save(tmp_path / "memory.dsc")
+    rows = sensor_rows(sensors)
+    for source in (streamed, folder, folder / "state.dsc", tmp_path / "memory.dsc"):
+        (run,) = page_data(ds.view(source, path=None))["runs"]
+        assert run["sensors"] == rows, source
+    # A log whose header holds the sensors (stream_header(sensors=...)) is drawn with them on its own.
+    from discsim.io.container import RecordWriter
+    from discsim.io.streams import stream_header
+
+    log = tmp_path / "header.dse"
+    meta, arrays = stream_header(
+        in_memory.run_context.log_origin(in_memory.discs)[0], in_memory.box, 0.0, "r", 0, sensors=sensors
+    )
+    with RecordWriter.create(log, ds.events.EVENT_DTYPE, meta, arrays) as writer:
+        writer.append(in_memory.events, {"time": 2.0})
+    assert ds.read_events(log).sensors == ds.iter_events(log).sensors == tuple(sensors)
+    for source in (log, ds.read_events(log)):
+        (run,) = page_data(ds.view(source, path=None))["runs"]
+        assert run["sensors"] == rows
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="run/observers.py does not yet pass the engine's sensors to stream_header (the lead's file): "
+    "remove this mark once it does",
+)
+def test_a_bare_log_streamed_by_a_run_holds_its_sensors(tmp_path):
+    sim, sensors = sensed_gas(record=False)
+    sim.run(until=1.0, record_to=tmp_path / "events.dse")
+    (run,) = page_data(ds.view(tmp_path / "events.dse", path=None))["runs"]
+    assert run["sensors"] == sensor_rows(sensors)
+
+
+def test_a_damaged_sensor_row_in_a_log_header_is_refused_by_name(tmp_path):
+    from discsim.io.container import RecordWriter
+    from discsim.io.streams import stream_header
+
+    discs, box = ds.random_gas(5, 0.2, seed=1)
+    meta, arrays = stream_header(discs, box, 0.0, "r", 0)
+    with RecordWriter.create(tmp_path / "none.dse", ds.events.EVENT_DTYPE, meta, arrays):
+        pass
+    assert ds.read_events(tmp_path / "none.dse").sensors == ()  # a header without sensors (an older log): none
+    meta["sensors"] = [[1, 2.0, 2.0, -1.0, 0.0]]  # a circle of negative radius
+    path = tmp_path / "bad.dse"
+    with RecordWriter.create(path, ds.events.EVENT_DTYPE, meta, arrays):
+        pass
+    with pytest.raises(ds.errors.CheckpointError, match=r"bad.dse.*sensors\[0\]"):
+        ds.read_events(path)
+    with pytest.raises(ds.errors.CheckpointError, match=r"bad.dse.*sensors\[0\]"):
+        ds.view(path, path=None)
+
+
+def test_the_page_draws_the_sensors_and_lights_one_a_disc_enters(tmp_path):
+    sim, _ = sensed_gas()
+    sim.run(until=2.0)
+    entered = sim.events[sim.events["kind"] == ds.events.ENTER]
+    t_enter, k = float(entered["time"][0]), int(entered["j"][0])
+    page = ds.view(sim, tmp_path / "sensors.html", speed=0.2)  # a flash lasts 0.3 s of playing: 0.06 here
+    script = (
+        "const out = []; for (const t of TIMES) { discsim.seek(t); out.push(discsim.sensors(0)); }"
+        "document.getElementById('ds-readout').textContent = JSON.stringify(out);"
+    ).replace("TIMES", json.dumps([t_enter - 0.01, t_enter, t_enter + 0.03, t_enter + 0.1]))
+    before, at, just_after, later = drive(page.path, tmp_path, script)
+    assert [s["shape"] for s in at] == ["circle", "rectangle", "line"]
+    assert not before[k]["lit"] and at[k]["lit"] and just_after[k]["lit"] and not later[k]["lit"]
+    # The screenshot shows the sensors' gold (outlines and the lit rectangle), which nothing else is drawn in.
+    shot = tmp_path / "sensors.png"
+    subprocess.run(
+        browser_args("--window-size=900,900", "--virtual-time-budget=1000", f"--screenshot={shot}", page.path.as_uri()),
+        capture_output=True,
+        timeout=120,
+        check=False,
+    )
+    assert shot.exists(), "Chromium wrote no screenshot"
+    pixels = matplotlib.image.imread(shot)[..., :3]
+    gold = np.array([0xB8, 0x86, 0x0B]) / 255.0
+    assert (np.abs(pixels - gold).max(axis=2) < 0.03).sum() > 100

@@ -8,12 +8,18 @@
 // discsim.physics.dynamics.advance's arithmetic. Where the run says how its discs turn, each record also holds
 // the disc's spin and angle (turning[2k], turning[2k + 1]), and a radius line on the disc shows its angle. A disc whose
 // state is NaN (before its ADD record, from its REMOVE record on: add_discs / remove_discs) is not drawn.
+// Sensors (rows [code, a0, a1, a2, a3]: 1 a circle, 2 a rectangle, 3 a trip wire) are drawn under the discs:
+// regions translucent and outlined, a wire dashed with a small arrow to its inside (the left of p1 - p0); a
+// sensor lights up for 0.3 s of playing after a disc enters it (the log's ENTER records).
 "use strict";
 (function () {
   const DATA = JSON.parse(document.getElementById("ds-data").textContent);
   const TAB10 = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
                  "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
   const OBSTACLE = "#8c8c8c";
+  const SENSOR = "#b8860b";  // dark goldenrod: apart from tab10 and viridis
+  const SENSOR_SHAPES = { 1: "circle", 2: "rectangle", 3: "line" };
+  const FLASH_SECONDS = 0.3;  // of playing (real time): a sensor stays lit this long after a disc enters it
   // viridis at 9 evenly spaced points, interpolated linearly
   const VIRIDIS = [[68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
                    [39, 173, 129], [92, 200, 99], [170, 220, 50], [253, 231, 37]];
@@ -51,7 +57,10 @@
       gravity: r.gravity || null, falls: decode(r.falls, Uint8Array),
       turning: r.turning ? decode(r.turning, Float64Array) : null,
       contactTimes: decode(r.contact_times, Float64Array), contactPairs: decode(r.contact_pairs, Int32Array),
+      sensors: r.sensors, enterTimes: decode(r.enter_times, Float64Array),
+      enterSensors: decode(r.enter_sensors, Int32Array),
     };
+    run.lit = new Uint8Array(run.sensors.length);
     run.x = new Float64Array(run.n);
     run.y = new Float64Array(run.n);
     run.rec = new Int32Array(run.n);
@@ -101,6 +110,57 @@
       if (periodic) { x = wrap(x, w); y = wrap(y, h); }
       run.x[d] = x; run.y[d] = y; run.rec[d] = k;
       if (turning) run.angle[d] = turning[2 * k + 1] + turning[2 * k] * (t - run.times[k]);
+    }
+  }
+
+  // Which sensors a disc entered in (t - the flash's span of simulated time, t] into run.lit.
+  // The entries are in time order: search for the last at or before t, then walk back through the span.
+  function light(run, t) {
+    run.lit.fill(0);
+    const span = FLASH_SECONDS * state.speed, times = run.enterTimes;
+    let lo = 0, hi = times.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (times[mid] <= t) lo = mid + 1; else hi = mid;
+    }
+    for (let e = lo - 1; e >= 0 && t - times[e] <= span; e--) run.lit[run.enterSensors[e]] = 1;
+  }
+
+  function drawSensors(ctx, run, X, Y, z) {
+    ctx.strokeStyle = SENSOR;
+    ctx.fillStyle = SENSOR;
+    for (let k = 0; k < run.sensors.length; k++) {
+      const [code, a0, a1, a2, a3] = run.sensors[k], lit = run.lit[k];
+      ctx.lineWidth = lit ? 3 : 1.5;
+      if (code === 3) {  // a trip wire: dashed (solid while lit), an arrow from its middle to its inside
+        ctx.setLineDash(lit ? [] : [6, 4]);
+        ctx.beginPath();
+        ctx.moveTo(X(a0), Y(a1));
+        ctx.lineTo(X(a2), Y(a3));
+        ctx.stroke();
+        ctx.setLineDash([]);
+        const len = Math.hypot(a2 - a0, a3 - a1), nx = -(a3 - a1) / len, ny = (a2 - a0) / len;
+        const bx = X((a0 + a2) / 2), by = Y((a1 + a3) / 2), ux = nx, uy = -ny;  // the canvas's y points down
+        const size = 12, ex = bx + size * ux, ey = by + size * uy, head = 5;
+        ctx.lineWidth = 1.5;
+        ctx.beginPath();
+        ctx.moveTo(bx, by);
+        ctx.lineTo(ex, ey);
+        ctx.stroke();
+        ctx.beginPath();
+        ctx.moveTo(ex, ey);
+        ctx.lineTo(ex - head * (ux + 0.5 * uy), ey - head * (uy - 0.5 * ux));
+        ctx.lineTo(ex - head * (ux - 0.5 * uy), ey - head * (uy + 0.5 * ux));
+        ctx.fill();
+        continue;
+      }
+      ctx.beginPath();
+      if (code === 1) ctx.arc(X(a0), Y(a1), Math.max(0.5, a2 * z), 0, 2 * Math.PI);
+      else ctx.rect(X(a0), Y(a3), (a2 - a0) * z, (a3 - a1) * z);
+      ctx.globalAlpha = lit ? 0.4 : 0.12;
+      ctx.fill();
+      ctx.globalAlpha = 1;
+      ctx.stroke();
     }
   }
 
@@ -212,6 +272,7 @@
     ctx.rect(X(0), Y(box.height), box.width * z, box.height * z);
     if (box.periodic) ctx.clip();  // discs crossing a periodic edge show on both sides
     const shifts = box.periodic ? [-1, 0, 1] : [0];
+    drawSensors(ctx, run, X, Y, z);
     for (let d = 0; d < run.n; d++) {
       const r = run.radii[d];
       if (!Number.isFinite(run.x[d])) continue;  // not there at t (added later, or removed)
@@ -357,7 +418,8 @@
   document.getElementById("ds-info").textContent =
     `${runs[0].n} discs, ${runs[0].box.periodic ? "periodic box" : "box with walls"} ` +
     `${+runs[0].box.width.toPrecision(6)} x ${+runs[0].box.height.toPrecision(6)}; t from ${T0} to ${T1}; ` +
-    `${eventTimes.length} event times; ${contacts.length / 2} exact contacts (outlined). ` +
+    `${eventTimes.length} event times; ${contacts.length / 2} exact contacts (outlined)` +
+    (runs[0].sensors.length ? `; ${runs[0].sensors.length} sensors (gold; lit when a disc enters). ` : ". ") +
     "Keys: Space play/pause, Left/Right one frame, Shift+Left/Right one event. " +
     "Zoom: the mouse wheel (or + and -), drag to move, double-click (or 0) for the whole box.";
 
@@ -365,6 +427,7 @@
   function render() {
     for (const p of panels) {
       evaluate(p.run, state.t);
+      light(p.run, state.t);
       p.run.drawnTime = state.t;
       draw(p, state.t);
     }
@@ -512,6 +575,13 @@
     return run.turning ? Array.from(run.angle) : null;
   }
 
+  // The sensors last drawn on a panel: [{shape, params: [a0, a1, a2, a3], lit}, ...] (lit: a disc entered it
+  // within the flash's span before the time drawn).
+  function sensors(panel = 0) {
+    const run = panels[panel].run;
+    return run.sensors.map((row, k) => ({ shape: SENSOR_SHAPES[row[0]], params: row.slice(1), lit: !!run.lit[k] }));
+  }
+
   // Writes {time, positions: [panel][disc][x, y]} into <pre id="ds-readout"> for tools that read the DOM.
   function readout() {
     const out = { time: state.t, drawn: panels.map((p) => p.run.drawnTime), positions: panels.map((_, k) => positions(k)) };
@@ -534,7 +604,7 @@
   window.addEventListener("resize", () => { layout(); render(); });
 
   window.discsim = {
-    seek, time: () => state.t, positions, angles, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
+    seek, time: () => state.t, positions, angles, sensors, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
     setColour, setZoom, setArrows, zoom: () => state.zoom, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
     labels: runs.map((r) => r.label), eventTimes: () => eventTimes.slice(),
   };

@@ -16,6 +16,7 @@ from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import iter_stream, read_stream, stream_index
 from discsim.model import Box, Discs
+from discsim.sensors import CIRCLE, LINE, RECTANGLE, Sensor
 from discsim.trajectory import LastRecords, check_times, flight, positions_from_log, replay
 
 __all__ = [
@@ -26,6 +27,7 @@ __all__ = [
     "StreamedEvents",
     "iter_events",
     "read_events",
+    "sensors_from_rows",
     "stream_header",
     "trajectory_from_events",
 ]
@@ -46,6 +48,7 @@ def stream_header(
     gravity=None,
     resting=None,
     drag: float = 0.0,
+    sensors=(),
 ) -> tuple[dict, dict]:
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
@@ -61,6 +64,8 @@ def stream_header(
             started in the middle of a run replays them at rest until their next record.
         drag: the run's drag ``gamma``, stored when not 0: replays (free flight and parabolas only) refuse the log
             then, naming it.
+        sensors: the run's :class:`~discsim.sensors.Sensor` s, stored when any as rows ``[code, a0, a1, a2, a3]``
+            (as checkpoints store them), so that a viewer of the log alone draws them.
     """
     meta = {
         "kind": STREAM_KIND,
@@ -74,6 +79,8 @@ def stream_header(
         meta["gravity"] = [float(gravity[0]), float(gravity[1])]
     if drag:
         meta["drag"] = float(drag)
+    if len(sensors):
+        meta["sensors"] = [[sensor.code, *sensor.params.tolist()] for sensor in sensors]
     arrays = {
         "positions": discs.positions,
         "velocities": discs.velocities,
@@ -104,6 +111,7 @@ class StreamedEvents:
         gravity: the run's ``(gx, gy)`` if it ran under gravity (:meth:`trajectory` follows its parabolas), else None.
         resting: ``(N,)`` bool, the ``discs`` at rest at ``start_time`` (under gravity), or None: none.
         drag: the run's drag ``gamma`` (0: none; :meth:`trajectory` follows its exponential flights).
+        sensors: the run's :class:`~discsim.sensors.Sensor` s, if its header holds them (else ``()``).
     """
 
     events: np.ndarray
@@ -116,6 +124,7 @@ class StreamedEvents:
     gravity: tuple | None = None
     resting: np.ndarray | None = None
     drag: float = 0.0
+    sensors: tuple = ()
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -193,7 +202,39 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
         None if gravity is None else tuple(gravity),
         _resting(path, stream.arrays, len(discs)),
         float(stream.meta.get("drag", 0.0)),
+        sensors_from_rows(stream.meta.get("sensors"), path),
     )
+
+
+def sensors_from_rows(rows, where) -> tuple[Sensor, ...]:
+    """The :class:`~discsim.sensors.Sensor` s stored as rows ``[code, a0, a1, a2, a3]`` (None: none), checked.
+
+    Args:
+        rows: the rows of an event log's header or a checkpoint's scene (``(S, 5)``: shape code, then
+            :attr:`~discsim.sensors.Sensor.params`).
+        where: the file they come from, named in the error.
+
+    Raises:
+        CheckpointError: naming the file and the first row that is not a valid sensor.
+    """
+    sensors = []
+    for k, row in enumerate(rows or ()):
+        try:
+            code, a0, a1, a2, a3 = (float(x) for x in row)
+            if code == CIRCLE:
+                sensor = Sensor.circle((a0, a1), a2)
+            elif code == RECTANGLE:
+                sensor = Sensor.rectangle((a0, a1), (a2, a3))
+            elif code == LINE:
+                sensor = Sensor.line((a0, a1), (a2, a3))
+            else:
+                msg = f"shape code {code!r} is none of {CIRCLE} (circle), {RECTANGLE} (rectangle), {LINE} (line)"
+                raise ValueError(msg)
+        except (TypeError, ValueError, DiscsimError) as exc:
+            msg = f"{where}: sensors[{k}] = {row!r} is not a sensor ({exc})"
+            raise CheckpointError(msg) from exc
+        sensors.append(sensor)
+    return tuple(sensors)
 
 
 def _resting(path, arrays, n: int) -> np.ndarray | None:
@@ -256,7 +297,7 @@ class EventChunks:
         unwrapped: the ``before`` positions are unwrapped (periodic box).
         gravity: the run's ``(gx, gy)`` from the header (None: free flight), which the unwrapped ``before``
             positions follow between records. resting: ``(N,)`` bool, the ``discs`` at rest where the log starts
-            (None: none).
+            (None: none). sensors: the run's :class:`~discsim.sensors.Sensor` s, if the header holds them.
     """
 
     path: Path
@@ -273,6 +314,7 @@ class EventChunks:
     partial: bool
     gravity: tuple | None = None
     resting: np.ndarray | None = None
+    sensors: tuple = ()
 
     def __iter__(self) -> Iterator[EventChunk]:
         carry = LastRecords.at_start(self.discs, self.start_time, self.ids, self.resting)
@@ -374,6 +416,7 @@ def iter_events(
         partial,
         None if gravity is None else (float(gravity[0]), float(gravity[1])),
         _resting(path, arrays, len(discs)),
+        sensors_from_rows(meta.get("sensors"), path),
     )
 
 

@@ -544,11 +544,6 @@ def test_the_sensors_come_back_from_a_stream_a_run_folder_and_a_checkpoint(tmp_p
         assert run["sensors"] == rows
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="run/observers.py does not yet pass the engine's sensors to stream_header (the lead's file): "
-    "remove this mark once it does",
-)
 def test_a_bare_log_streamed_by_a_run_holds_its_sensors(tmp_path):
     sim, sensors = sensed_gas(record=False)
     sim.run(until=1.0, record_to=tmp_path / "events.dse")

@@ -201,7 +201,8 @@ class EventStream(Observer):
         gravity = laws.gravity if laws is not None and laws.falls else None
         resting = None if from_start else getattr(engine, "resting", None)  # a log from mid-run: who rests then
         drag = laws.drag if laws is not None else 0.0
-        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids, gravity, resting, drag)
+        sensors = getattr(engine, "sensors", ())
+        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids, gravity, resting, drag, sensors)
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
         self._created = True
         context.stream = {

@@ -17,6 +17,10 @@ each law in turn (so a slow spell hits them alike), ``--repeats`` times (default
   about half its kinetic energy while it is timed): exponential flight, every time in closed form.
 * ``gravity+drag``: both (walls and cell edges along gravity by bracketed roots; the gas falls towards its
   terminal velocity).
+* ``sensors``: elastic, with six circle sensors (pockets a tenth of the box across) and two trip wires across the
+  box (issue 28): every disc's prediction also asks when it next changes sides of each sensor over its cell.
+* ``moving segment``: elastic, a lid across the box above every disc, coming down at a hundredth of the rms
+  speed (issue 28): it is checked from every cell.
 
 Under any law but the first the pure-Python backend runs the compiled loop's source interpreted (its own loop
 knows free flight only). The issue's target: the compiled backend within 1.5x of its elastic rate under gravity
@@ -33,7 +37,10 @@ from benchutils import Column, call_fresh, format_table, machine_summary, median
 
 import discsim as ds
 
-LAWS = ("elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough", "drag", "gravity+drag")
+LAWS = (
+    "elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough", "drag", "gravity+drag",
+    "sensors", "moving segment",
+)  # fmt: skip
 KEYS = ["backend", "law", "n", "events", "collisions_per_s", "ratio_to_elastic", "repeats"]
 COLUMNS = [
     Column("backend", "backend", "s"),
@@ -62,6 +69,19 @@ def keywords(law: str, discs, box) -> dict:
         out["roughness"] = 0.5
     if law == "perfectly rough":
         out["roughness"] = 1.0
+    w, h = box.width, box.height
+    if law == "sensors":
+        pockets = [ds.Sensor.circle((x, y), 0.05 * w) for x in (0.1 * w, 0.5 * w, 0.9 * w) for y in (0.1 * h, 0.9 * h)]
+        out["sensors"] = [
+            *pockets,
+            ds.Sensor.line((0.0, 0.5 * h), (w, 0.5 * h)),
+            ds.Sensor.line((0.5 * w, 0.0), (0.5 * w, h)),
+        ]
+    if law == "moving segment":
+        top = float((discs.positions[:, 1] + discs.radii).max())
+        rms = float(((discs.velocities**2).sum(axis=1).mean()) ** 0.5)
+        lid = ds.Segment((-1.0, 0.5 * (top + h)), (w + 1.0, 0.5 * (top + h)), velocity=(0.0, -0.01 * rms))
+        out["segments"] = [lid]
     return out
 
 

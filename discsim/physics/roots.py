@@ -28,6 +28,7 @@ __all__ = [
     "concave_piece",
     "convex_piece",
     "crossing_time",
+    "inflections",
     "linear_contact",
     "linear_exit",
 ]
@@ -226,6 +227,28 @@ def concave_piece(
             hi = t
 
 
+def inflections(dx: float, dy: float, dvx: float, dvy: float, ax: float, ay: float, horizon: float):
+    """Where ``f(t) = |d + w t + a t^2 / 2|^2 - sigma^2`` turns from convex to concave and back in ``[0, horizon]``:
+    ``(first, second)``, the roots of ``f''(t) / 2 = A t^2 + 2 B t + C`` (cancellation-free) within it
+    (``horizon`` twice when ``f''`` keeps its sign): ``f`` is convex before the first and after the second,
+    concave between."""
+    a2 = ax * ax + ay * ay
+    qa = 1.5 * a2
+    qb = 1.5 * (dvx * ax + dvy * ay)
+    qc = dvx * dvx + dvy * dvy + dx * ax + dy * ay
+    first = second = horizon
+    disc = qb * qb - qa * qc
+    if disc > 0.0:
+        q = -(qb + math.copysign(math.sqrt(disc), qb))
+        r1, r2 = q / qa, qc / q
+        if r1 > r2:
+            r1, r2 = r2, r1
+        # Within [0, horizon], written out (not min and max: no -0.0 where one root is -0.0)
+        first = 0.0 if r1 <= 0.0 else (horizon if r1 >= horizon else r1)
+        second = 0.0 if r2 <= 0.0 else (horizon if r2 >= horizon else r2)
+    return first, second
+
+
 def accelerated_time_of_impact(
     dx: float, dy: float, dvx: float, dvy: float, ax: float, ay: float, sigma: float
 ) -> float:
@@ -313,21 +336,7 @@ def accelerated_time_of_impact(
     t = 0.0 if t <= 0.0 else (horizon if t >= horizon else t)
     if along0 + t * (along_rate + t * 0.5 * a_norm) > reach or (along0 < -reach and along1 < -reach):
         return INF
-    # f''(t) / 2 = A t^2 + 2 B t + C: its roots (cancellation-free) cut [0, horizon] into pieces where f is
-    # convex (before the first, after the second) or concave (between them).
-    qa = 1.5 * a2
-    qb = 1.5 * (dvx * ax + dvy * ay)
-    qc = w2 + dx * ax + dy * ay
-    first = second = horizon
-    disc = qb * qb - qa * qc
-    if disc > 0.0:
-        q = -(qb + math.copysign(math.sqrt(disc), qb))
-        r1, r2 = q / qa, qc / q
-        if r1 > r2:
-            r1, r2 = r2, r1
-        # Within [0, horizon], written out (not min and max: no -0.0 where one root is -0.0)
-        first = 0.0 if r1 <= 0.0 else (horizon if r1 >= horizon else r1)
-        second = 0.0 if r2 <= 0.0 else (horizon if r2 >= horizon else r2)
+    first, second = inflections(dx, dy, dvx, dvy, ax, ay, horizon)
     s2 = sigma * sigma
     t = INF
     if first > 0.0:
@@ -407,6 +416,7 @@ PARTS = (
     crossing_time,
     convex_piece,
     concave_piece,
+    inflections,
     accelerated_time_of_impact,
     accelerated_exit,
 )

@@ -32,7 +32,7 @@ import math
 
 from discsim.physics.damped import damped_exit, time_of_span
 from discsim.physics.dynamics import advance, exit_x, exit_y
-from discsim.physics.roots import accelerated_time_of_impact, linear_contact
+from discsim.physics.roots import accelerated_time_of_impact, inflections, linear_contact
 
 __all__ = [
     "accelerated_leave",
@@ -213,18 +213,7 @@ def accelerated_leave(dx: float, dy: float, dvx: float, dvy: float, ax: float, a
     a_norm = math.sqrt(a2)
     horizon = 2.0 * (math.sqrt(w2) + math.sqrt(w2 + 2.0 * a_norm * (math.sqrt(dx * dx + dy * dy) + sigma))) / a_norm
     horizon *= 1.0 + 1e-9
-    qa = 1.5 * a2
-    qb = 1.5 * (dvx * ax + dvy * ay)
-    qc = w2 + dx * ax + dy * ay
-    first = second = horizon
-    disc = qb * qb - qa * qc
-    if disc > 0.0:
-        q = -(qb + math.copysign(math.sqrt(disc), qb))
-        r1, r2 = q / qa, qc / q
-        if r1 > r2:
-            r1, r2 = r2, r1
-        first = 0.0 if r1 <= 0.0 else (horizon if r1 >= horizon else r1)
-        second = 0.0 if r2 <= 0.0 else (horizon if r2 >= horizon else r2)
+    first, second = inflections(dx, dy, dvx, dvy, ax, ay, horizon)
     t = INF
     if first > 0.0:
         t = _leave_piece(0.0, first, True, dx, dy, dvx, dvy, hx, hy, s2)

@@ -17,7 +17,7 @@ import numpy as np
 from discsim.cells import neighbour_pair_chunks
 from discsim.engines.context import LookOnly, RunContext, readonly_ids
 from discsim.errors import DiscsimError, InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
-from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, _real_array
+from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, Segment, _real_array
 from discsim.scene import Scene, check_added
 
 __all__ = ["DiscEditing", "Uneditable"]
@@ -54,6 +54,11 @@ class DiscEditing:
 
     def _check_editable(self, what: str) -> None:
         """Refuse ``what`` (an edit, or a callback) before anything changes, where the engine cannot take it."""
+
+    def _moved_segments(self, segments: tuple) -> None:
+        """Go on over ``segments`` from now (an engine that moves segments says how); refused here."""
+        msg = f"{type(self).__name__} cannot change a segment's velocity yet (EventDriven can)"
+        raise InvalidArgumentError(msg)
 
     #: Event kinds a callback can follow with :meth:`on`.
     CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment", "enter", "leave")
@@ -257,6 +262,31 @@ class DiscEditing:
         """``run_context.next_id`` (read-only here)."""
         return self.run_context.next_id
 
+    def set_segment_velocity(self, k: int, velocity):
+        """Move segment ``k`` at ``velocity`` ``(2,)`` (length / time) from now on, from where it is now: a paddle
+        the player steers, a pusher that starts or stops (``(0, 0)``). The run goes on from here exactly (every
+        disc is predicted again: O(N)). ``EventDriven`` only, under the laws moving segments take (see
+        :class:`~discsim.model.Segment`). Returns ``self``.
+
+        Raises:
+            InvalidArgumentError: ``k`` that is not a segment's index, or ``velocity`` that is not 2 finite numbers
+                (naming it), or laws under which segments may not move; nothing changes.
+        """
+        self._check_editable("change a segment's velocity")
+        n = len(self.segments)
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < n:
+            msg = f"segment index {k!r} does not exist (this simulation has segments 0 to {n - 1})"
+            raise InvalidArgumentError(msg)
+        v = _real_array("velocity", velocity, InvalidArgumentError)
+        if v.shape != (2,) or not np.isfinite(v).all():
+            msg = f"segment {k}'s velocity must be 2 finite numbers, got {v.tolist()}"
+            raise InvalidArgumentError(msg)
+        here = self.segments[int(k)].at(self.time)
+        moved = Segment(here.p0 - v * self.time, here.p1 - v * self.time, v)  # where it is now, at time now
+        self._moved_segments((*self.segments[:k], moved, *self.segments[k + 1 :]))
+        self._edits += 1
+        return self
+
     def on(self, kind: str, fn, *, changes: bool = True):
         """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"``, ``"segment"``, or a
         sensor's ``"enter"`` and ``"leave"``).
@@ -440,6 +470,9 @@ class Uneditable:
 
     def _set_discs(self, indices, positions, velocities) -> None:
         self._refuse("change discs")
+
+    def _moved_segments(self, segments) -> None:
+        self._refuse("change a segment's velocity")
 
     def _restructure(self, keep, added, scene) -> None:
         self._refuse("add or remove discs")

@@ -21,7 +21,7 @@ from discsim.engines.event_driven.numbering import fresh_state
 from discsim.engines.event_driven.protocol import BackendClass
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
-from discsim.engines.event_driven.stops import RunStops
+from discsim.engines.event_driven.stops import RunStops, check_parts
 from discsim.engines.event_driven.turning import Turning
 from discsim.errors import CheckpointError, InvalidArgumentError
 from discsim.events import KIND_NAMES, Event
@@ -36,25 +36,6 @@ INF = math.inf
 #: (the type checker checks both classes against it, through
 #: :class:`~discsim.engines.event_driven.protocol.BackendClass`).
 BACKENDS: dict[str, BackendClass] = {"python": PythonBackend, "numba": NumbaBackend}
-
-
-def _check_parts(scene: Scene, laws: Laws) -> None:
-    """Refuse, by name, the sensors and moving segments the loop does not time yet under ``laws``."""
-    if laws.falls and laws.drag:
-        for k, sensor in enumerate(scene.sensors):
-            if sensor.shape == "circle":
-                msg = (
-                    f"sensors[{k}] {sensor!r}: circle sensors are not yet timed under gravity and drag at once "
-                    f"(gravity={laws.gravity}, drag={laws.drag}); a rectangle or lines work"
-                )
-                raise InvalidArgumentError(msg)
-    if scene.moving and (laws.falls or laws.drag or laws.rough):
-        k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
-        msg = (
-            f"segments[{k}] {scene.segments[k]!r} moves: moving segments run under the default laws or "
-            f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
-        )
-        raise InvalidArgumentError(msg)
 
 
 @register_engine
@@ -167,7 +148,7 @@ class EventDriven(Turning, RunStops, Engine):
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
         scene = Scene(discs, box, segments, pass_through, sensors=sensors)
-        _check_parts(scene, laws)
+        check_parts(scene, laws)
         self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()
 
@@ -304,6 +285,9 @@ class EventDriven(Turning, RunStops, Engine):
             # wakes (a removed disc may have held others up; those still held come to rest again at once)
             state.dissipated = old.dissipated
             state.last_collision[: len(keep)] = old.export().last_collision[keep]
+        sensed = old.export().sensed if scene.sensors else None  # the kept discs keep their sides of the sensors
+        if sensed is not None and sensed.shape[1] == len(scene.sensors):
+            state.sensed[: len(keep)] = sensed[keep]
         spins, angles = old.turning()  # the kept discs keep turning (added ones start with their own spins)
         state.spins[: len(keep)], state.angles[: len(keep)] = spins[keep], angles[keep]
         spin_log = getattr(old, "spin_log", None)

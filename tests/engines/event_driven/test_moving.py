@@ -140,3 +140,33 @@ def test_a_fixed_segment_is_unchanged():
     s = ds.Segment((0.0, 0.0), (1.0, 0.0))
     assert not s.moving and s.at(5.0) is s and repr(s) == "Segment([0.0, 0.0], [1.0, 0.0])"
     assert math.isclose(ds.Segment((0, 0), (0, 1), velocity=(2, 0)).at(1.5).p0[0], 3.0)
+
+
+def test_a_paddle_steered_mid_run_stays_where_it_is_and_moves_on_at_its_new_velocity(tmp_path):
+    # Fixed at x = 8 until t = 2, then sweeping left at 2: it meets the disc's edge (x = 2.5) at 2 + 5.5 / 2.
+    paddle = ds.Segment((8.0, 3.0), (8.0, 7.0))
+    sim = ds.EventDriven(ball(2.0, 5.0), BOX, segments=[paddle]).run(until=2.0)
+    assert sim.backend in ("python", "numba")
+    sim.set_segment_velocity(0, (-2.0, 0.0))
+    assert sim.segments[0].at(2.0).p0 == pytest.approx([8.0, 3.0])
+    event = sim.step()
+    assert event.time == pytest.approx(2.0 + 5.5 / 2.0, rel=1e-14)
+    assert sim.velocities[0] == pytest.approx([-4.0, 0.0], rel=1e-14)
+    sim.set_segment_velocity(0, (0.0, 0.0))  # stopped where it is: x = 8 - 2 * (t - 2)
+    sim.run(until=6.0)
+    assert sim.segments[0].at(6.0).p0 == pytest.approx([8.0 - 2.0 * (4.75 - 2.0), 3.0])  # where it stopped
+    sim.save(tmp_path / "steered.npz")
+    assert ds.load(tmp_path / "steered.npz").segments[0].velocity.tolist() == [0.0, 0.0]
+
+
+def test_steering_a_segment_is_refused_by_name_and_changes_nothing():
+    sim = ds.EventDriven(ball(2.0, 5.0), BOX, segments=[ds.Segment((8.0, 3.0), (8.0, 7.0))], gravity=(0.0, -1.0))
+    with pytest.raises(InvalidArgumentError, match="segments\\[0\\]"):
+        sim.set_segment_velocity(0, (1.0, 0.0))
+    assert not sim.segments[0].moving
+    with pytest.raises(InvalidArgumentError, match="segment index 3"):
+        sim.set_segment_velocity(3, (1.0, 0.0))
+    with pytest.raises(InvalidArgumentError, match="velocity"):
+        sim.set_segment_velocity(0, (float("inf"), 0.0))
+    with pytest.raises(InvalidArgumentError, match="FixedStep cannot change a segment"):
+        ds.FixedStep(ball(2.0, 5.0), BOX, segments=[ds.Segment((8.0, 3.0), (8.0, 7.0))]).set_segment_velocity(0, (1, 0))

@@ -71,6 +71,8 @@ def fall_to_zero(u: float, v: float, a: float, drag: float) -> float:
     s = math.sqrt(d)
     if v > 0.0:  # rises, turns, falls through 0 (the larger root, without cancellation)
         return (v + s) / -a
+    if s == 0.0 and v == 0.0:  # at rest at 0 (or so near it that 2 a u underflows): not 0 / 0
+        return math.sqrt(2.0 * u / -a) if u > 0.0 else 0.0
     return 2.0 * u / (s - v)
 
 

@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
+from discsim.physics import dynamics
 from discsim.physics.sources import sensors as src
-from discsim.physics.sources.sensors import line_time
+from discsim.physics.sources.sensors import line_time, rectangle_time
 from discsim.sensors import Sensor
 
 G = 9.81
@@ -33,6 +35,29 @@ def test_a_disc_on_a_wire_crosses_at_once_only_moving_or_pulled_to_its_left():
         assert t == pytest.approx(6.0 / G, rel=1e-15) if drag == 0.0 else 0.0 < t < 6.0 / G
 
 
+def test_a_disc_on_a_rectangles_edge_enters_at_once_only_moving_or_pulled_inwards():
+    box = (0.0, 0.0, 2.0, 1.0)
+    assert not Sensor.rectangle(box[:2], box[2:]).contains([[0.0, 0.5], [1.0, 1.0], [2.0, 0.0]]).any()
+    assert rectangle_time(0.0, 0.5, 1.0, 0.0, *NO, *box, False) == 0.0  # inwards through the left edge
+    assert rectangle_time(2.0, 0.5, -1.0, 0.3, *NO, *box, False) == 0.0  # inwards through the right edge
+    assert rectangle_time(0.0, 0.0, 1.0, 1.0, *NO, *box, False) == 0.0  # inwards through a corner
+    assert rectangle_time(0.0, 0.5, -1.0, 0.0, *NO, *box, False) == math.inf  # outwards
+    assert rectangle_time(1.0, 1.0, 0.3, 1.0, *NO, *box, False) == math.inf  # outwards through the top
+    assert rectangle_time(0.0, 0.5, 0.0, 0.0, *NO, *box, False) == math.inf  # at rest
+    assert rectangle_time(0.0, -1.0, 0.0, 1.0, *NO, *box, False) == math.inf  # up along the left edge's line
+    assert rectangle_time(1.0, 1.0, 1.0, 0.0, *NO, *box, False) == math.inf  # along the top edge
+    assert rectangle_time(0.0, 0.5, -1.0, 0.0, 0.0, 0.0, 0.5, *box, False) == math.inf  # outwards under drag
+    assert rectangle_time(1.0, 1.0, 0.0, 0.0, 0.0, -G, 0.0, *box, False) == 0.0  # at rest on the top, falling
+    assert rectangle_time(1.0, 1.0, 0.0, 0.0, 0.0, -G, 0.5, *box, False) == 0.0  # ... under drag too
+    assert rectangle_time(1.0, 0.0, 0.0, 0.0, 0.0, -G, 0.0, *box, False) == math.inf  # on the bottom, falling away
+    # Through a corner, touching it only: never in (it was: the other coordinate, leaving its slab, was on its edge).
+    assert rectangle_time(-1.0, 0.0, 1.0, 1.0, *NO, *box, False) == math.inf  # the corner (0, 1)
+    assert rectangle_time(3.0, 2.0, -1.0, -1.0, *NO, 0.0, 1.0, 2.0, 2.0, False) == math.inf  # (2, 1)
+    assert rectangle_time(3.0, 0.0, -1.0, 1.0, *NO, 0.0, 1.0, 2.0, 2.0, False) == 1.0  # in through (2, 1)
+    # Thrown up off the top: back in when it comes down, 2 v / g later.
+    assert rectangle_time(1.0, 1.0, 0.0, 3.0, 0.0, -G, 0.0, *box, False) == pytest.approx(6.0 / G, rel=1e-15)
+
+
 def test_a_coordinate_at_rest_at_zero_pulled_down_crosses_at_once_not_zero_over_zero():
     # fall_to_zero's root 2 u / (s - v) was 0 / 0 there (ZeroDivisionError; nan compiled): a disc at rest on a wire,
     # pulled across it.
@@ -41,3 +66,18 @@ def test_a_coordinate_at_rest_at_zero_pulled_down_crosses_at_once_not_zero_over_
     # So near 0 that 2 a u underflows to 0: still sqrt(2 u / -a).
     assert src.fall_to_zero(1e-310, 0.0, -1e-300, 0.0) == pytest.approx(math.sqrt(2e-10), rel=1e-9)
     assert src.fall_to_zero(4.0, 0.0, -2.0, 0.0) == 2.0
+
+
+def test_a_rectangle_entered_through_an_edge_is_never_missed_when_the_entry_point_rounds_outside():
+    # Up through the bottom edge y = y0 at (y0 - y) / vy. The centre there, y + vy t, rounds below y0 about half
+    # the time; the search then stepped by less than an ulp of the entry time, got stuck, and answered inf (20% of
+    # these entries were missed).
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        x, y, vy, y0 = rng.uniform(0.2, 1.8), rng.uniform(-5.0, 0.0), rng.uniform(0.1, 5.0), rng.uniform(0.5, 2.0)
+        t = rectangle_time(x, y, 0.0, vy, *NO, 0.0, y0, 2.0, y0 + 3.0, False)
+        assert t == pytest.approx((y0 - y) / vy, rel=1e-15, abs=1e-15)
+        # ... and under gravity and drag, where the entry is a root found to adjacent floats.
+        t = rectangle_time(x, y, 0.0, vy + 20.0, 0.0, -G, 0.3, 0.0, y0, 2.0, y0 + 3.0, False)
+        yt = dynamics.advance(x, y, 0.0, vy + 20.0, t, 0.0, -G, 0.3)[1]
+        assert t < math.inf and yt == pytest.approx(y0, abs=1e-13)

@@ -97,10 +97,11 @@ def line_time(
 
 
 def _enter_slab(x: float, v: float, a: float, drag: float, lo: float, hi: float) -> float:
-    """Time until a coordinate enters the slab ``lo <= x <= hi`` (0 if in it now), or ``inf``."""
-    if x < lo:
+    """Time until a coordinate enters the slab ``lo < x < hi`` (0 if in it now), or ``inf``. On an edge it is
+    outside (:meth:`discsim.sensors.Sensor.contains`): it enters at once only moving (or pulled) inwards."""
+    if x <= lo:
         return fall_to_zero(lo - x, -v, -a, drag)
-    if x > hi:
+    if x >= hi:
         return fall_to_zero(x - hi, v, a, drag)
     return 0.0
 
@@ -138,7 +139,10 @@ def rectangle_time(
         if t == 0.0:
             return start
         qx, qy, wx, wy = advance(x, y, vx, vy, start + t, ax, ay, drag)
-        if x0 <= qx <= x1 and y0 <= qy <= y1:
+        # The coordinate that enters last is on its edge then by construction (its position may round a hair
+        # outside: a step to it would not move start, and the entry would be missed); the other must be in, not
+        # on its edge (leaving it: the path only touches a corner).
+        if (tx == t or x0 < qx < x1) and (ty == t or y0 < qy < y1):
             return start + t
         start += t
         px, py, ux, uy = qx, qy, wx, wy

@@ -27,7 +27,49 @@ __all__ = ["DiscEditing", "Uneditable"]
 _DISC_FIELDS = ("positions", "velocities", "radii", "masses", "groups", "spins", "inertia")
 
 
-class DiscEditing:
+class SegmentEditing:
+    """``set_segment_velocity``: a segment steered during a run (a mixin of the engines, through
+    :class:`DiscEditing`)."""
+
+    segments: tuple
+    time: float
+    _edits: int
+
+    def _check_editable(self, what: str) -> None:
+        """Refuse ``what`` before anything changes, where the engine cannot take it."""
+
+    def set_segment_velocity(self, k: int, velocity):
+        """Move segment ``k`` at ``velocity`` ``(2,)`` (length / time) from now on, from where it is now: a paddle
+        the player steers, a pusher that starts or stops (``(0, 0)``). The run goes on from here exactly (every
+        disc is predicted again: O(N)). ``EventDriven`` only, under the laws moving segments take (see
+        :class:`~discsim.model.Segment`). Returns ``self``.
+
+        Raises:
+            InvalidArgumentError: ``k`` that is not a segment's index, or ``velocity`` that is not 2 finite numbers
+                (naming it), or laws under which segments may not move; nothing changes.
+        """
+        self._check_editable("change a segment's velocity")
+        n = len(self.segments)
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < n:
+            msg = f"segment index {k!r} does not exist (this simulation has segments 0 to {n - 1})"
+            raise InvalidArgumentError(msg)
+        v = _real_array("velocity", velocity, InvalidArgumentError)
+        if v.shape != (2,) or not np.isfinite(v).all():
+            msg = f"segment {k}'s velocity must be 2 finite numbers, got {v.tolist()}"
+            raise InvalidArgumentError(msg)
+        here = self.segments[int(k)].at(self.time)
+        moved = Segment(here.p0 - v * self.time, here.p1 - v * self.time, v)  # where it is now, at time now
+        self._moved_segments((*self.segments[:k], moved, *self.segments[k + 1 :]))
+        self._edits += 1
+        return self
+
+    def _moved_segments(self, segments: tuple) -> None:
+        """Go on over ``segments`` from now (an engine that moves segments says how); refused here."""
+        msg = f"{type(self).__name__} cannot change a segment's velocity yet (EventDriven can)"
+        raise InvalidArgumentError(msg)
+
+
+class DiscEditing(SegmentEditing):
     """The disc-editing methods every engine shares (see the module docstring)."""
 
     # What the engine gives these methods (declared for type checkers; Engine sets or defines each).
@@ -54,11 +96,6 @@ class DiscEditing:
 
     def _check_editable(self, what: str) -> None:
         """Refuse ``what`` (an edit, or a callback) before anything changes, where the engine cannot take it."""
-
-    def _moved_segments(self, segments: tuple) -> None:
-        """Go on over ``segments`` from now (an engine that moves segments says how); refused here."""
-        msg = f"{type(self).__name__} cannot change a segment's velocity yet (EventDriven can)"
-        raise InvalidArgumentError(msg)
 
     #: Event kinds a callback can follow with :meth:`on`.
     CALLBACK_KINDS: ClassVar[tuple[str, ...]] = ("collision", "wall", "segment", "enter", "leave")
@@ -261,31 +298,6 @@ class DiscEditing:
     def _next_id(self) -> int:
         """``run_context.next_id`` (read-only here)."""
         return self.run_context.next_id
-
-    def set_segment_velocity(self, k: int, velocity):
-        """Move segment ``k`` at ``velocity`` ``(2,)`` (length / time) from now on, from where it is now: a paddle
-        the player steers, a pusher that starts or stops (``(0, 0)``). The run goes on from here exactly (every
-        disc is predicted again: O(N)). ``EventDriven`` only, under the laws moving segments take (see
-        :class:`~discsim.model.Segment`). Returns ``self``.
-
-        Raises:
-            InvalidArgumentError: ``k`` that is not a segment's index, or ``velocity`` that is not 2 finite numbers
-                (naming it), or laws under which segments may not move; nothing changes.
-        """
-        self._check_editable("change a segment's velocity")
-        n = len(self.segments)
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < n:
-            msg = f"segment index {k!r} does not exist (this simulation has segments 0 to {n - 1})"
-            raise InvalidArgumentError(msg)
-        v = _real_array("velocity", velocity, InvalidArgumentError)
-        if v.shape != (2,) or not np.isfinite(v).all():
-            msg = f"segment {k}'s velocity must be 2 finite numbers, got {v.tolist()}"
-            raise InvalidArgumentError(msg)
-        here = self.segments[int(k)].at(self.time)
-        moved = Segment(here.p0 - v * self.time, here.p1 - v * self.time, v)  # where it is now, at time now
-        self._moved_segments((*self.segments[:k], moved, *self.segments[k + 1 :]))
-        self._edits += 1
-        return self
 
     def on(self, kind: str, fn, *, changes: bool = True):
         """Call ``fn(sim, contact)`` after each event of ``kind`` (``"collision"``, ``"wall"``, ``"segment"``, or a

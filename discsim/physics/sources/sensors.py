@@ -73,6 +73,8 @@ def fall_to_zero(u: float, v: float, a: float, drag: float) -> float:
     s = math.sqrt(d)
     if v > 0.0:  # rises, turns, falls through 0 (the larger root, without cancellation)
         return (v + s) / -a
+    if s == 0.0 and v == 0.0:  # at rest at 0 (or so near it that 2 a u underflows): not 0 / 0
+        return math.sqrt(2.0 * u / -a) if u > 0.0 else 0.0
     return 2.0 * u / (s - v)
 
 
@@ -97,8 +99,8 @@ def line_time(
 
 
 def _enter_slab(x: float, v: float, a: float, drag: float, lo: float, hi: float) -> float:
-    """Time until a coordinate enters the slab ``lo < x < hi`` (0 if in it now, or on its edge moving in), or
-    ``inf``; on an edge moving out (just left), the time it comes back."""
+    """Time until a coordinate enters the slab ``lo < x < hi`` (0 if in it now), or ``inf``. On an edge it is
+    outside (:meth:`discsim.sensors.Sensor.contains`): it enters at once only moving (or pulled) inwards."""
     if x <= lo:
         return fall_to_zero(lo - x, -v, -a, drag)
     if x >= hi:
@@ -139,7 +141,10 @@ def rectangle_time(
         if t == 0.0:
             return start
         qx, qy, wx, wy = advance(x, y, vx, vy, start + t, ax, ay, drag)
-        if x0 <= qx <= x1 and y0 <= qy <= y1:
+        # The coordinate that enters last is on its edge then by construction (its position may round a hair
+        # outside: a step to it would not move start, and the entry would be missed); the other must be in, not
+        # on its edge (leaving it: the path only touches a corner).
+        if (tx == t or x0 < qx < x1) and (ty == t or y0 < qy < y1):
             return start + t
         start += t
         px, py, ux, uy = qx, qy, wx, wy
@@ -193,25 +198,38 @@ def _leave_piece(
 
 def accelerated_leave(dx: float, dy: float, dvx: float, dvy: float, ax: float, ay: float, sigma: float) -> float:
     """Time until a point ``(dx, dy)`` from a centre, moving at ``(dvx, dvy)`` under ``(ax, ay)`` (not both 0),
-    first gets farther than ``sigma`` from it; 0 if it is farther now.
+    first gets farther than ``sigma`` from it; 0 if it is farther now and not heading in.
 
     ``f(t) = |d + w t + a t^2 / 2|^2 - sigma^2`` is convex or concave between the roots of ``f''`` (as in
     :func:`~discsim.physics.roots.accelerated_time_of_impact`), and ``f > 0`` past
     ``T = 2 (|w| + sqrt(|w|^2 + 2 |a| (|d| + sigma))) / |a|``: the first piece that ends outside holds the
     crossing, and a concave piece inside at both ends may still rise out at its maximum.
 
+    A point farther than ``sigma`` (by roundoff: just entered) but heading in leaves as if it were on the edge,
+    not at once. An acceleration outside ``1e-100 < max(|ax|, |ay|) < 1e100`` is taken in a time unit of a power
+    of two in which it is about 1, as :func:`~discsim.physics.roots.accelerated_time_of_impact` does.
+
     Example:
         >>> accelerated_leave(0.0, 0.0, 0.0, 0.0, 0.0, -2.0, 1.0)  # dropped at the centre: out just after 1
         1.0000000000000002
     """
-    hx, hy = 0.5 * ax, 0.5 * ay
     s2 = sigma * sigma
-    if dx * dx + dy * dy - s2 > 0.0:
-        return 0.0
+    r2 = dx * dx + dy * dy
+    if r2 - s2 > 0.0:
+        if dx * dvx + dy * dvy >= 0.0:
+            return 0.0
+        s2, sigma = r2, math.sqrt(r2)  # f(0) = 0: on the edge
+    unit = 1.0
+    largest = max(abs(ax), abs(ay))
+    if not 1e-100 < largest < 1e100:  # |a|^2 would underflow or overflow: exact scaling, bit for bit
+        k = -(math.frexp(largest)[1] // 2)
+        ax, ay, dvx, dvy = math.ldexp(ax, 2 * k), math.ldexp(ay, 2 * k), math.ldexp(dvx, k), math.ldexp(dvy, k)
+        unit = math.ldexp(1.0, k)
+    hx, hy = 0.5 * ax, 0.5 * ay
     a2 = ax * ax + ay * ay
     w2 = dvx * dvx + dvy * dvy
     a_norm = math.sqrt(a2)
-    horizon = 2.0 * (math.sqrt(w2) + math.sqrt(w2 + 2.0 * a_norm * (math.sqrt(dx * dx + dy * dy) + sigma))) / a_norm
+    horizon = 2.0 * (math.sqrt(w2) + math.sqrt(w2 + 2.0 * a_norm * (math.sqrt(r2) + sigma))) / a_norm
     horizon *= 1.0 + 1e-9
     first, second = inflections(dx, dy, dvx, dvy, ax, ay, horizon)
     t = INF
@@ -221,7 +239,7 @@ def accelerated_leave(dx: float, dy: float, dvx: float, dvy: float, ax: float, a
         t = _leave_piece(first, second, False, dx, dy, dvx, dvy, hx, hy, s2)
     if t == INF and horizon > second:
         t = _leave_piece(second, horizon, True, dx, dy, dvx, dvy, hx, hy, s2)
-    return t
+    return t * unit
 
 
 def _linear_leave(dx: float, dy: float, vx: float, vy: float, r: float) -> float:

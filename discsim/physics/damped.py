@@ -197,6 +197,8 @@ def _rising_root(start: float, x: float, v: float, a: float, gamma: float, line:
     drag dominates), and ``x(start) + u tau + a tau^2 / 2`` (``tau = tau(dt)``; since ``s >= tau^2 / 2``: tight
     when the drag is weak, as the parabola's root); then :func:`_root`."""
     q, u = _position(start, x, v, a, gamma)
+    if q >= line:  # there already (at rest on the line, or over it by roundoff): the rise below is 0 / 0
+        return start
     u = max(u, 0.0)
     vt = a / gamma
     end = start + (line - q + max(0.0, vt - u) / gamma) / vt * (1.0 + 1e-9)

@@ -96,8 +96,7 @@ class EventDriven(Turning, RunStops, Engine):
             ``.rectangle``, ``.line``) that never touch the motion: the exact time each disc's centre enters or
             leaves one is an event, logged with kind ``"enter"`` or ``"leave"`` (``j`` the sensor's index) and
             passed to ``sim.on("enter" | "leave", fn)``; counted in ``counts["sensor_events"]`` and in
-            ``run(events=...)``. They run on the compiled loop, as laws other than the defaults do. Not yet:
-            circles under gravity and drag at once.
+            ``run(events=...)``. They run on the compiled loop, as laws other than the defaults do.
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.

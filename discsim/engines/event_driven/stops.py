@@ -29,16 +29,8 @@ INF = math.inf
 
 
 def check_parts(scene: Scene, laws) -> None:
-    """Refuse, by name, the sensors and moving segments the loop does not time yet under ``laws`` (a
+    """Refuse, by name, the moving segments the loop does not time yet under ``laws`` (a
     :class:`~discsim.laws.Laws`)."""
-    if laws.falls and laws.drag:
-        for k, sensor in enumerate(scene.sensors):
-            if sensor.shape == "circle":
-                msg = (
-                    f"sensors[{k}] {sensor!r}: circle sensors are not yet timed under gravity and drag at once "
-                    f"(gravity={laws.gravity}, drag={laws.drag}); a rectangle or lines work"
-                )
-                raise InvalidArgumentError(msg)
     if scene.moving and (laws.falls or laws.drag or laws.rough):
         k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
         msg = (

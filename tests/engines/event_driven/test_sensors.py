@@ -240,12 +240,25 @@ def test_a_periodic_gas_counts_the_flux_through_a_wire():
             ),
             "inside the periodic box",
         ),
-        (
-            lambda: ds.EventDriven(ball(1.0, 1.0), BOX, gravity=(0, -1), drag=0.1, sensors=[Sensor.circle((5, 5), 1)]),
-            "gravity and drag",
-        ),
     ],
 )
 def test_bad_sensors_are_refused_by_name(make, words):
     with pytest.raises(InvalidArgumentError, match=re.escape(words)):
         make()
+
+
+def test_a_ball_falling_under_drag_through_a_circle_enters_and_leaves_where_its_fall_says():
+    gamma = 0.8
+
+    def fallen(h):  # the time a ball dropped from rest has fallen h: (g / gamma)(t - tau(t)) = h, by bisection
+        lo, hi = 0.0, 20.0
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if G / gamma * (mid + math.expm1(-gamma * mid) / gamma) < h else (lo, mid)
+        return hi
+
+    sim = ds.EventDriven(ball(5.0, 9.0), BOX, gravity=(0.0, -G), drag=gamma, sensors=[Sensor.circle((5.0, 5.0), 1.0)])
+    sim.run(until=2.5)
+    (t0, k0, *_), (t1, k1, *_) = crossings(sim)
+    assert (k0, k1) == ("enter", "leave")
+    assert t0 == pytest.approx(fallen(3.0), rel=1e-10) and t1 == pytest.approx(fallen(5.0), rel=1e-10)

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from discsim.events import ADD, COLLISION, REMOVE, WALL
+from discsim.events import ADD, COLLISION, REMOVE, SENSED, WALL
 from discsim.physics.dynamics import advance
 
 __all__ = ["event_losses"]
@@ -56,7 +56,7 @@ def event_losses(
 
     Returns:
         ``(E,)`` float: each collision's or wall hit's loss (>= 0 up to roundoff; 0 when elastic and smooth), 0
-        for ``SET``, ``ADD`` and ``REMOVE`` records.
+        for ``SET``, ``ADD``, ``REMOVE``, ``ENTER`` and ``LEAVE`` records.
     """
     n = len(masses)
     gx, gy = float(gravity[0]), float(gravity[1])
@@ -77,6 +77,8 @@ def event_losses(
         if kind == REMOVE:
             continue
         physical = kind in (COLLISION, WALL)
+        if kind in SENSED:  # j is a sensor, not a disc (and the motion does not change)
+            j = -1
         lost = 0.0
         for d, vx, vy, w_slot in ((i, record[6], record[7], 3), (j, record[10], record[11], 4)):
             if d < 0:

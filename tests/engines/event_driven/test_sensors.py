@@ -262,3 +262,13 @@ def test_a_ball_falling_under_drag_through_a_circle_enters_and_leaves_where_its_
     (t0, k0, *_), (t1, k1, *_) = crossings(sim)
     assert (k0, k1) == ("enter", "leave")
     assert t0 == pytest.approx(fallen(3.0), rel=1e-10) and t1 == pytest.approx(fallen(5.0), rel=1e-10)
+
+
+def test_the_losses_of_a_run_with_sensors_sum_to_what_it_dissipated():
+    discs, box = ds.random_gas(20, 0.3, seed=1, periodic=False)
+    sensors = [Sensor.circle(box.size / 2, box.width / 4), Sensor.line((0.0, 1.0), (box.width, 2.0))]
+    sim = ds.EventDriven(discs, box, restitution=0.9, sensors=sensors).run(until=3.0)
+    losses = sim.event_losses()
+    assert np.isin(sim.events["kind"], SENSED).any()
+    assert (losses[np.isin(sim.events["kind"], SENSED)] == 0.0).all()
+    assert losses.sum() == pytest.approx(sim.dissipated, rel=1e-10)

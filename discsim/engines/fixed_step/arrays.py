@@ -243,7 +243,8 @@ class Tally:
     """
 
     NAMES = (
-        "frames", "pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits", "list_builds", "sensed"
+        "frames", "pair_tests", "segment_tests", "bisection_tests", "detections", "wall_hits", "list_builds",
+        "sensor_events",
     )  # fmt: skip
 
     def __init__(

@@ -359,7 +359,7 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
     def _event_count(self) -> int:
         """Log records produced since the start: one per detection, wall or segment hit, edit and sensor crossing."""
         counts = self._tally.counts
-        return counts["detections"] + counts["wall_hits"] + self._edits + counts["sensed"]
+        return counts["detections"] + counts["wall_hits"] + self._edits + counts["sensor_events"]
 
     def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
         paths, t = self._paths, self.time

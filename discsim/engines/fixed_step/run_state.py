@@ -89,7 +89,7 @@ class FixedStepRun:
             last_collision=paths.last_collision.copy(),
             spins=spins,
             angles=angles,
-            sensed=counts["sensed"],
+            sensor_events=counts["sensor_events"],
         )
 
     def _load(self, state: FixedStepState) -> None:

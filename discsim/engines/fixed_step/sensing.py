@@ -64,7 +64,7 @@ class FrameSensing:
         if not len(records):
             return []
         tally = self._tally
-        tally.counts["sensed"] += len(records)
+        tally.counts["sensor_events"] += len(records)
         if tally.log is not None:
             tally.log.extend(records)
         return [event_from_record(record) for record in records]

@@ -29,9 +29,9 @@ class FixedStepState(EngineState):
         frames: frames done since the start.
         pair_tests, segment_tests, bisection_tests, detections, wall_hits, list_builds:
             the counters (see ``FixedStep.counts``).
-        sensed: the sensor records (``ENTER``, ``LEAVE``) since the start (``FixedStep.counts["sensed"]``). The
-            sensors' inside state at the last frame is that of ``frame_positions`` (``Sensor.contains``): it needs
-            no field of its own.
+        sensor_events: the sensor records (``ENTER``, ``LEAVE``) since the start (``FixedStep.counts["sensor_events"]``,
+            as ``EventDriven``'s). The sensors' inside state at the last frame is that of ``frame_positions``
+            (``Sensor.contains``): it needs no field of its own.
         max_overlap: the deepest disc-disc overlap seen, as a fraction of the contact distance.
         virial: the sum over the disc-disc impulses applied since the start of ``dp_i . (r_i - r_j)``
             (energy; ``FixedStep.pressure()``); NaN when unknown (a version 1 state: see below).
@@ -59,7 +59,7 @@ class FixedStepState(EngineState):
     ``FixedStep`` rebuilds from the event log when the log covers the whole run. 1 and 2 had no laws
     (``dissipated``, ``last_collision``): they are read with their defaults, 0 and ``-inf``. 1 to 3 had no
     spins (``spins``, ``angles``): they are read with zeros (the discs did not turn). 1 to 4 had no sensors
-    (``sensed``): they are read with 0.
+    (``sensor_events``): they are read with 0.
     """
 
     VERSION = 5
@@ -87,7 +87,7 @@ class FixedStepState(EngineState):
     last_collision: np.ndarray = None  # type: ignore[assignment]  # None: no response yet (filled in below)
     spins: np.ndarray = None  # type: ignore[assignment]  # None: zeros (filled in below)
     angles: np.ndarray = None  # type: ignore[assignment]  # None: zeros
-    sensed: int = 0
+    sensor_events: int = 0
 
     def __post_init__(self) -> None:
         n = len(self.ref_times)
@@ -102,7 +102,8 @@ class FixedStepState(EngineState):
     def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int) -> FixedStepState:
         """As :meth:`EngineState.from_arrays`; a version 1 state (before ``virial``) gets ``virial = NaN``, and a
         version 1 or 2 state (before the laws) ``dissipated = 0`` and no last responses, and a version 1 to 3 state
-        (before the spins) spins and angles zero, and a version 1 to 4 state (before the sensors) ``sensed = 0``."""
+        (before the spins) spins and angles zero, and a version 1 to 4 state (before the sensors)
+        ``sensor_events = 0``."""
         if version == 1 and "virial" not in scalars:
             scalars = {**scalars, "virial": math.nan}
             version = 2
@@ -116,7 +117,7 @@ class FixedStepState(EngineState):
             arrays = {**arrays, "spins": np.zeros(n), "angles": np.zeros(n)}
             version = 4
         if version == 4:
-            scalars = {**scalars, "sensed": 0}
+            scalars = {**scalars, "sensor_events": 0}
             version = cls.VERSION
         return super().from_arrays(scalars, arrays, version)
 
@@ -131,5 +132,5 @@ class FixedStepState(EngineState):
             "detections": self.detections,
             "wall_hits": self.wall_hits,
             "list_builds": self.list_builds,
-            "sensed": self.sensed,
+            "sensor_events": self.sensor_events,
         }

@@ -98,7 +98,7 @@ def test_records_come_by_disc_then_sensor_and_step_returns_them(policy):
     assert sim.step() == [*expected, Event(0.25, "enter", 1, 1)]
     assert sim.step() == []
     assert rows(sim) == [(0.25, ENTER, 0, 0), (0.25, ENTER, 0, 1), (0.25, ENTER, 1, 0), (0.25, ENTER, 1, 1)]
-    assert sim.counts["sensed"] == 4
+    assert sim.counts["sensor_events"] == 4
 
 
 @pytest.mark.parametrize("policy", POLICIES)
@@ -217,9 +217,9 @@ def test_a_streamed_run_in_two_calls_keeps_its_log(tmp_path):
 
 def test_a_version_4_state_reads_with_no_sensor_records():
     scalars, arrays = gas_with_sensors().run(frames=5).state().to_arrays()
-    old = {name: value for name, value in scalars.items() if name != "sensed"}
+    old = {name: value for name, value in scalars.items() if name != "sensor_events"}
     state = FixedStepState.from_arrays(old, arrays, 4)
-    assert state.sensed == 0 and FixedStepState.VERSION == 5
+    assert state.sensor_events == 0 and FixedStepState.VERSION == 5
 
 
 def test_sensor_records_name_discs_by_id_after_a_removal():
@@ -292,7 +292,7 @@ def test_bad_sensors_are_refused_by_name(sensors, named):
 
 def test_no_sensors_log_nothing_and_cost_nothing():
     sim = ds.FixedStep(lone(1.0, 5.0, 1.0, 0.0), ds.Box(10.0, 10.0), dt=DT).run(until=2.0)
-    assert sim.sensors == () and sim.counts["sensed"] == 0 and len(sensed(sim)) == 0
+    assert sim.sensors == () and sim.counts["sensor_events"] == 0 and len(sensed(sim)) == 0
 
 
 @pytest.mark.parametrize(

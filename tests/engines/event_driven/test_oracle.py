@@ -54,12 +54,14 @@ def test_mixed_radii_masses_and_obstacles_follow_the_oracle(periodic):
     _lockstep_times(ds.EventDriven(discs, ds.Box(side, side, periodic=periodic)), 300)
 
 
+@pytest.mark.slow_on_python  # (the pure-Python loop's oracle runs cover it: test_equal_discs_follow_the_oracle)
 @pytest.mark.parametrize("queue", ["heap", "sorted"])
 def test_dense_gas_follows_the_oracle_with_the_other_queues(queue):
     discs, box = ds.random_gas(36, 0.6, periodic=True, seed=3)
     _lockstep_times(ds.EventDriven(discs, box, queue=queue), 300)
 
 
+@pytest.mark.slow_on_python
 def test_large_cells_follow_the_oracle():
     discs, box = ds.random_gas(50, 0.2, periodic=True, seed=4)
     _lockstep_times(ds.EventDriven(discs, box, cell_size=box.width / 3.5), 200)

@@ -6,6 +6,7 @@ import random
 import tracemalloc
 
 import numpy as np
+import pytest
 
 import discsim as ds
 from discsim.events import EVENT_DTYPE, EventLog
@@ -37,6 +38,7 @@ def test_the_log_holds_about_one_record_of_89_bytes_per_event():
     assert array["i"][:3].tolist() == [0, 1, 2] and len(array) == n
 
 
+@pytest.mark.slow
 def test_the_log_behaves_as_a_list_of_records():
     """collision, wall, extend, since, clear, len and to_array against a plain list, at random."""
     rng = random.Random(1)

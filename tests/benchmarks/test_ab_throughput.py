@@ -29,6 +29,7 @@ def ab_throughput():
         yield module
 
 
+@pytest.mark.slow
 def test_quick_run_against_itself_writes_one_row(ab_throughput, tmp_path):
     assert ab_throughput.main(["--quick", "--base", str(REPO), "--out", str(tmp_path)]) == 0
     with open(tmp_path / "ab_throughput.csv", newline="") as handle:
@@ -84,6 +85,7 @@ def test_quick_run_of_the_compiled_loop(ab_throughput, tmp_path):
     assert len(rows) == 1 and rows[0]["backend"] == "numba" and float(rows[0]["new_median"]) > 0
 
 
+@pytest.mark.slow
 def test_fixed_step_mode_times_frames(ab_throughput, tmp_path):
     argv = ["--quick", "--engine", "fixed-step", "--collisions", "20", "--base", str(REPO), "--out", str(tmp_path)]
     assert ab_throughput.main(argv) == 0

@@ -133,6 +133,7 @@ def test_bullets_pass_through_each_other_but_hit_targets():
     assert {int(first["i"]), int(first["j"])} == {0, 1}
 
 
+@pytest.mark.slow_on_python
 def test_filtered_gas_follows_the_oracle_and_allows_overlaps_within_passing_groups():
     discs, box = ds.random_gas(40, 0.3, seed=8)
     groups = np.arange(40) % 3

@@ -84,7 +84,7 @@ def test_a_head_on_pair_separates_faster_than_it_grows():
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-@pytest.mark.parametrize("periodic", [True, False])
+@pytest.mark.parametrize("periodic", [pytest.param(True, marks=pytest.mark.slow), False])  # periodic: 3 s
 def test_bookkeeping_and_no_overlaps_along_the_way(backend, periodic):
     discs, box = ds.random_gas(120, 0.5, periodic=periodic, seed=2, radii=[1.0, 1.4])
     pos, vel, radii, masses = discs.positions, discs.velocities, discs.radii.copy(), discs.masses

@@ -33,6 +33,7 @@ def test_equal_discs_follow_the_oracle(periodic, seed):  # seed 0 quick; 1 and 2
     _lockstep_times(ds.EventDriven(discs, box), 300)
 
 
+@pytest.mark.slow_on_python
 @pytest.mark.parametrize("periodic", [False, True])
 def test_mixed_radii_masses_and_obstacles_follow_the_oracle(periodic):
     rng = np.random.default_rng(7)

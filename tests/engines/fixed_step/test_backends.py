@@ -114,7 +114,7 @@ def test_both_backends_give_the_same_frames_bit_for_bit(scene, policy, broad_pha
 @needs_numba
 @pytest.mark.parametrize("broad_phase", ["grid", "all-pairs"])
 @pytest.mark.parametrize("policy", SUB_FRAME_POLICIES)
-@pytest.mark.parametrize("scene", ["walled", "periodic"])
+@pytest.mark.parametrize("scene", ["walled", pytest.param("periodic", marks=pytest.mark.slow)])  # periodic: 6 s
 def test_the_sub_frame_policies_give_the_same_frames_bit_for_bit(scene, policy, broad_phase):
     """Chains of contacts inside frames, walls, a triangle of segments, obstacles, three radii and masses,
     groups passing through each other: the same log, state and counters (bisection tests too)."""

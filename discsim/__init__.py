@@ -56,6 +56,7 @@ from discsim.io.gsd import read_gsd, write_gsd
 from discsim.io.streams import StreamedEvents, iter_events, read_events, trajectory_from_events
 from discsim.io.xyz import read_xyz, write_xyz
 from discsim.model import Box, Discs, Segment, polygon
+from discsim.piston import Piston
 from discsim.run import driver as _driver  # noqa: F401 (it provides Engine.run: discsim.engines.base.provide)
 from discsim.run import tasks
 from discsim.run.observers import Callback, Checkpointer, EventStream, Observer, ProgressBar
@@ -112,6 +113,7 @@ __all__ = [
     "OutsideBoxError",
     "OverlapError",
     "PackingError",
+    "Piston",
     "ProgressBar",
     "RayHit",
     "Sampler",

@@ -47,8 +47,10 @@ class EventKind(IntEnum):
     ``remove_discs``; ``j`` is -1; see :class:`EventLog` for their fields), ``ENTER`` and ``LEAVE`` (a disc's
     centre enters or leaves a sensor, :class:`discsim.Sensor`: ``j`` is the sensor's index, the ``i`` fields the
     disc's centre and velocity then; the motion does not change) only; ``CROSSING`` (a disc enters another
-    cell), ``SEGMENT`` (a segment hit, logged as ``WALL``) and ``SENSOR`` (a centre changes sides of a sensor,
-    logged as ``ENTER`` or ``LEAVE``, or not at all beyond a trip wire's ends) live in the engines' queues.
+    cell), ``SEGMENT`` (a segment hit, logged as ``WALL``), ``SENSOR`` (a centre changes sides of a sensor,
+    logged as ``ENTER`` or ``LEAVE``, or not at all beyond a trip wire's ends) and ``PISTON`` (a disc meets the
+    piston, :class:`discsim.Piston`: logged as ``WALL``, with the piston's height after in ``yj`` and its
+    velocity in ``vyj``) live in the engines' queues.
     """
 
     COLLISION = 0
@@ -61,6 +63,7 @@ class EventKind(IntEnum):
     SENSOR = 7
     ENTER = 8
     LEAVE = 9
+    PISTON = 10
 
 
 COLLISION = int(EventKind.COLLISION)

@@ -7,6 +7,7 @@ engine and every check uses (:meth:`Scene.passes`).
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -14,6 +15,7 @@ import numpy as np
 from discsim.cells import neighbour_pair_chunks
 from discsim.errors import InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
 from discsim.model import OVERLAP_TOLERANCE, RESOLUTION, Box, Discs, Segment, normalize_pass_through
+from discsim.piston import Piston
 from discsim.sensors import check_sensors
 
 __all__ = ["Scene", "check_added", "check_fits", "check_scene", "filter_table"]
@@ -222,11 +224,13 @@ class Scene:
         pass_through: pairs of group labels whose discs pass through each other.
         sensors: :class:`~discsim.sensors.Sensor` regions and trip wires (none by default); in a periodic box
             a circle or rectangle must lie inside the box.
+        piston: a :class:`~discsim.piston.Piston` as the top wall of a walled box (None: none); every disc's top
+            ``y + r`` at most its height, which is at most the box's.
         check: False for the scene of discs an engine already holds (``add_discs`` checks the new ones with
             :func:`check_added`): ``segments`` and ``pass_through`` as a scene holds them, no check at all.
 
     Attributes:
-        discs, box: as given. segments (tuple[Segment, ...]), sensors (tuple[Sensor, ...]): as given.
+        discs, box: as given. segments (tuple[Segment, ...]), sensors (tuple[Sensor, ...]), piston: as given.
         pass_through (frozenset[tuple[int, int]]): sorted group pairs.
         group ((N,) int64): each disc's group as an index into ``blocked``.
         blocked ((G, G) bool): True where two groups pass through each other.
@@ -245,7 +249,10 @@ class Scene:
         [True]
     """
 
-    def __init__(self, discs: Discs, box: Box, segments=(), pass_through=(), *, sensors=(), check: bool = True):
+    def __init__(
+        self, discs: Discs, box: Box, segments=(), pass_through=(), *, sensors=(), piston=None, check: bool = True
+    ):
+        self.piston = piston
         if not check:  # the discs, segments and filter of an engine's own scene, validated when they came in
             self.segments, self.pass_through = tuple(segments), frozenset(pass_through)
             self.sensors = tuple(sensors)
@@ -271,7 +278,29 @@ class Scene:
                     raise InvalidArgumentError(msg)
         self.discs = discs
         self.box = box
+        if piston is not None:
+            _check_piston(piston, discs, box)
         self.group, self.blocked = filter_table(discs.groups, self.pass_through)
+
+    def but(self, discs: Discs | None = None, segments: tuple | None = None) -> Scene:
+        """This scene with other ``discs`` or ``segments`` (None: these), everything else kept, nothing checked:
+        for the discs and segments an engine already holds."""
+        return Scene(
+            self.discs if discs is None else discs,
+            self.box,
+            self.segments if segments is None else segments,
+            self.pass_through,
+            sensors=self.sensors,
+            piston=self.piston,
+            check=False,
+        )
+
+    @property
+    def piston_height(self) -> float:
+        """The piston's height at time 0 (the box's height when it was given none); nan without a piston."""
+        if self.piston is None:
+            return math.nan
+        return self.box.height if self.piston.height is None else self.piston.height
 
     @property
     def moving(self) -> bool:
@@ -289,3 +318,23 @@ class Scene:
 
     def __len__(self) -> int:
         return len(self.discs)
+
+
+def _check_piston(piston, discs: Discs, box: Box) -> None:
+    """Refuse a piston that is not a :class:`~discsim.piston.Piston`, in a periodic box, above the box or below a
+    disc's top, naming the disc."""
+    if not isinstance(piston, Piston):
+        msg = f"piston must be a discsim.Piston, got {type(piston).__name__} {_short(piston)}"
+        raise WrongTypeError(msg)
+    if box.periodic:
+        msg = "a piston is the top wall of a walled box; this box is periodic"
+        raise InvalidArgumentError(msg)
+    height = box.height if piston.height is None else piston.height
+    if height > box.height:
+        msg = f"piston height {height!r} is above the box's height {box.height!r}"
+        raise InvalidArgumentError(msg)
+    tops = discs.positions[:, 1] + discs.radii if len(discs) else np.zeros(0)
+    if (tops > height).any():
+        k = int(np.argmax(tops))
+        msg = f"disc {k}'s top y + r = {float(tops[k])!r} is above the piston's height {height!r}"
+        raise OutsideBoxError(msg)

@@ -13,6 +13,7 @@ FLOORS = {
     "ground": [
         "model",
         "sensors",
+        "piston",
         "queue",
         "errors",
         "_validate",

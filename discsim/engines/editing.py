@@ -213,7 +213,7 @@ class DiscEditing(SegmentEditing):
         everyone = Discs(*(np.concatenate([getattr(now, name), getattr(discs, name)]) for name in _DISC_FIELDS))
         scene = self.scene
         check_added(everyone, self.box, n, [s.at(self.time) for s in scene.segments], scene.pass_through)
-        new_scene = Scene(everyone, self.box, scene.segments, scene.pass_through, sensors=scene.sensors, check=False)
+        new_scene = scene.but(everyone)
         context = self.run_context
         ids = np.arange(context.next_id, context.next_id + k, dtype=np.int64)
         ids_after, origin = np.concatenate([self.ids, ids]), self._log_origin()
@@ -259,7 +259,7 @@ class DiscEditing(SegmentEditing):
         gone_positions, gone_velocities = now.positions[np.sort(idx)], now.velocities[np.sort(idx)]
         rest = Discs(*(getattr(now, name)[keep] for name in _DISC_FIELDS))
         scene = self.scene
-        new_scene = Scene(rest, self.box, scene.segments, scene.pass_through, sensors=scene.sensors, check=False)
+        new_scene = scene.but(rest)
         gone, ids_after, origin = self.ids[np.sort(idx)], self.ids[keep], self._log_origin()
         resting = _resting_ids(self)
         self._restructure(keep, None, new_scene)

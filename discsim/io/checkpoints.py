@@ -39,6 +39,7 @@ from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
 from discsim.model import Box, Discs, Segment, image_steps
+from discsim.piston import Piston
 from discsim.scene import Scene
 from discsim.sensors import Sensor
 from discsim.trajectory import reconstruct
@@ -81,6 +82,7 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
             ],
             "pass_through": sorted(scene.pass_through),
             "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in scene.sensors],
+            **({} if getattr(scene, "piston", None) is None else {"piston": scene.piston.settings()}),
         },
         "settings": {**engine._settings(), "record": record},
         "state_version": engine.STATE.VERSION,
@@ -241,10 +243,13 @@ def load(path, *, backend: str | None = None):
                     for row in scene_meta.get("segments", [])]  # fmt: skip
         pass_through = [tuple(pair) for pair in scene_meta.get("pass_through", [])]
         sensors = [Sensor(int(row[0]), row[1:]) for row in scene_meta.get("sensors", [])]
+        piston = Piston(*scene_meta["piston"]) if scene_meta.get("piston") is not None else None
         if changed:
-            scene = Scene(discs, box, tuple(segments), frozenset(pass_through), sensors=sensors, check=False)
+            scene = Scene(
+                discs, box, tuple(segments), frozenset(pass_through), sensors=sensors, piston=piston, check=False
+            )
         else:
-            scene = Scene(discs, box, segments, pass_through, sensors=sensors)
+            scene = Scene(discs, box, segments, pass_through, sensors=sensors, piston=piston)
         sim = engine._restore(scene, settings, state, events, float(meta["start_time"]))
         if "spin_events" in arrays:
             sim._restore_spin_events(arrays["spin_events"])

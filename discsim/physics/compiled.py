@@ -15,7 +15,7 @@ from discsim import model
 from discsim._compiled import compile_from_source, interpret, jit
 from discsim._numba import numba
 from discsim.physics import damped, dynamics, laws, roots
-from discsim.physics.sources import boundaries, pairs, sensors
+from discsim.physics.sources import boundaries, pairs, piston, sensors
 
 __all__ = [
     "DYNAMICS",
@@ -31,6 +31,9 @@ __all__ = [
     "pair_predict",
     "pair_resolve",
     "pair_time_of_impact",
+    "piston_at",
+    "piston_bounce",
+    "piston_contact",
     "predict_x",
     "predict_y",
     "reflect",
@@ -64,6 +67,7 @@ _SOURCES = (
     boundaries.cross,
     boundaries.wall_time,
     *sensors.PARTS,
+    *piston.PARTS,
 )
 #: The names the compiled loops import, and the source of each.
 _NAMES = {
@@ -80,6 +84,9 @@ _NAMES = {
     "sensor_predict": sensors.predict,
     "sensor_contains": sensors.contains,
     "sensor_on_wire": sensors.on_wire,
+    "piston_at": piston.at,
+    "piston_contact": piston.contact_time,
+    "piston_bounce": piston.bounce,
 }
 
 
@@ -133,3 +140,6 @@ wall_time = _parts["wall_time"]
 sensor_predict = _parts["sensor_predict"]
 sensor_contains = _parts["sensor_contains"]
 sensor_on_wire = _parts["sensor_on_wire"]
+piston_at = _parts["piston_at"]
+piston_contact = _parts["piston_contact"]
+piston_bounce = _parts["piston_bounce"]

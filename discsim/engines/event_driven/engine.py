@@ -18,6 +18,7 @@ from discsim.cells import CellGrid
 from discsim.engines.base import Engine, register_engine
 from discsim.engines.event_driven.numba import NumbaBackend
 from discsim.engines.event_driven.numbering import fresh_state
+from discsim.engines.event_driven.piston import PistonRun
 from discsim.engines.event_driven.protocol import BackendClass
 from discsim.engines.event_driven.python import QUEUES, PythonBackend
 from discsim.engines.event_driven.state import EventDrivenState
@@ -39,7 +40,7 @@ BACKENDS: dict[str, BackendClass] = {"python": PythonBackend, "numba": NumbaBack
 
 
 @register_engine
-class EventDriven(Turning, RunStops, Engine):
+class EventDriven(PistonRun, Turning, RunStops, Engine):
     """Exact event-driven simulation of hard discs (PIC): elastic by default, or under gravity, with restitution.
 
     Args:
@@ -97,6 +98,9 @@ class EventDriven(Turning, RunStops, Engine):
             leaves one is an event, logged with kind ``"enter"`` or ``"leave"`` (``j`` the sensor's index) and
             passed to ``sim.on("enter" | "leave", fn)``; counted in ``counts["sensor_events"]`` and in
             ``run(events=...)``. They run on the compiled loop, as laws other than the defaults do.
+        piston: a :class:`~discsim.piston.Piston` that makes the box's top wall a piston of finite mass under a
+            constant pressure (a run at constant pressure: :attr:`piston`, :meth:`set_piston`), or a kinematic lid;
+            None: none. Compiled loop, default laws only (``docs/users/piston.md``).
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.
@@ -142,11 +146,12 @@ class EventDriven(Turning, RunStops, Engine):
         roughness: float = -1.0,
         drag: float = 0.0,
         sensors=(),
+        piston=None,
     ):
         laws = Laws.build(gravity, restitution, tc, rest_speed, roughness, drag)
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
-        scene = Scene(discs, box, segments, pass_through, sensors=sensors)
+        scene = Scene(discs, box, segments, pass_through, sensors=sensors, piston=piston)
         check_parts(scene, laws)
         self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()
@@ -159,7 +164,7 @@ class EventDriven(Turning, RunStops, Engine):
         self._auto = isinstance(backend, str) and backend == "auto"
         #: physical events the Python loop still runs before ``"auto"`` takes the compiled one (None: no switch)
         self._auto_events: int | None = None
-        compiled_laws = not laws.default or bool(scene.sensors) or scene.moving  # the loop that reads the laws
+        compiled_laws = not _plain(laws, scene)  # the loop that reads the laws
         if self._auto and compiled_laws:  # the interpreted loop is slow: the compiled one from the start
             backend = "numba" if available() else "python"
         elif self._auto:
@@ -178,7 +183,7 @@ class EventDriven(Turning, RunStops, Engine):
     def _new_backend(self, name: str, scene: Scene, grid: CellGrid):
         """The backend ``name`` over the engine's laws: the default laws run on :data:`BACKENDS`; others on the
         compiled loop (``"python"``: that loop's source, interpreted), and so do sensors."""
-        if self.laws.default and not scene.sensors and not scene.moving:
+        if _plain(self.laws, scene):
             return BACKENDS[name](scene, grid, self.queue_kind)
         return NumbaBackend(scene, grid, self.queue_kind, interpreted=name == "python", laws=self.laws)
 
@@ -292,6 +297,7 @@ class EventDriven(Turning, RunStops, Engine):
         spin_log = getattr(old, "spin_log", None)
         if spin_log and hasattr(backend, "spin_log"):
             backend.spin_log = spin_log
+        state.piston = self._piston_from(scene.discs)
         if last is not None:
             state.last_time, state.last_kind, state.last_i, state.last_j = last
         if box.periodic and len(keep):
@@ -434,3 +440,8 @@ class EventDriven(Turning, RunStops, Engine):
         from discsim.engines.event_driven.invariants import check
 
         check(self)
+
+
+def _plain(laws: Laws, scene: Scene) -> bool:
+    """Whether both backends' own loops run ``scene`` under ``laws`` (else the loop that reads the laws)."""
+    return laws.default and not scene.sensors and not scene.moving and scene.piston is None

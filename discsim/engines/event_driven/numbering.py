@@ -61,6 +61,8 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
     cell = grid.cells_of(discs.positions)
     members = order[np.argsort(cell[order], kind="stable")]  # by cell, then internal number
     empty_queue = np.zeros(0, dtype=np.int64)
+    given = scene.piston  # its height and velocity at time 0, no impact yet, its pressure
+    piston = np.zeros(0) if given is None else np.array([scene.piston_height, given.velocity, 0.0, 0.0, given.pressure])
     return EventDrivenState(
         time=0.0,
         epoch=0.0,
@@ -101,4 +103,5 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
         spins=np.array(discs.spins),
         angles=np.zeros(n),
         sensed=inside_table(scene.sensors, discs.positions),
+        piston=piston,
     )

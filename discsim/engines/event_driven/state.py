@@ -19,9 +19,10 @@ __all__ = ["EventDrivenState"]
 
 @dataclass(eq=False)
 class EventDrivenState(EngineState):
-    """Everything an event-driven run needs to continue bit for bit (version 4: version 1 plus the laws' fields
-    (version 2), the discs' turning (version 3) and the sensors' (version 4); an older state reads the fields it
-    lacks as their defaults: no disc at rest, no collision recorded, spins and angles zero, no sensor).
+    """Everything an event-driven run needs to continue bit for bit (version 5: version 1 plus the laws' fields
+    (version 2), the discs' turning (version 3), the sensors' (version 4) and the piston's (version 5); an older
+    state reads the fields it lacks as their defaults: no disc at rest, no collision recorded, spins and angles zero,
+    no sensor, no piston).
 
     Per-disc arrays are indexed in the caller's numbering (as ``discs``); disc
     indices inside arrays (partners, cell members, queue owners) too. Times in
@@ -65,12 +66,15 @@ class EventDrivenState(EngineState):
         sensed ``(N, S)`` int64: 1 where disc ``i``'s centre is inside sensor ``k`` (:class:`discsim.Sensor`; a
             line's left side) as the run knows it (a disc on the edge just after crossing it counts as crossed);
             ``(N, 0)`` without sensors, or unknown: the backend then takes it from where the discs are.
+        piston ``(5,)``: the piston's (:class:`discsim.Piston`) height and velocity at the internal time ``piston[2]``
+            (counted from ``epoch``, as ``ref_times``), its impacts so far (the stamp of the contacts predicted with
+            it, in ``queue_stamp``) and the pressure on it; ``(0,)`` without a piston.
 
     Scalars of the laws: dissipated (kinetic energy lost in collisions and by discs coming to rest),
     rests (discs put to rest). Of the sensors: sensor_events (enter and leave events).
     """
 
-    VERSION = 4
+    VERSION = 5
 
     time: float
     epoch: float
@@ -114,6 +118,7 @@ class EventDrivenState(EngineState):
     angles: np.ndarray = None  # type: ignore[assignment]  # None: zeros
     sensed: np.ndarray = None  # type: ignore[assignment]  # None: (N, 0), taken from the positions when loaded
     sensor_events: int = 0
+    piston: np.ndarray = None  # type: ignore[assignment]  # None: (0,), no piston
 
     def __post_init__(self) -> None:
         n = len(self.order)
@@ -127,11 +132,13 @@ class EventDrivenState(EngineState):
             self.angles = np.zeros(n)
         if self.sensed is None:
             self.sensed = np.zeros((n, 0), dtype=np.int64)
+        if self.piston is None:
+            self.piston = np.zeros(0)
 
     @classmethod
     def from_arrays(cls, scalars: dict, arrays: dict[str, np.ndarray], version: int):
         """As :meth:`EngineState.from_arrays`; a version-1 state (before the laws) gets their defaults, a version-1
-        or 2 state (before spins) spins and angles zero, a version 1 to 3 state no sensor."""
+        or 2 state (before spins) spins and angles zero, a version 1 to 3 state no sensor, 1 to 4 no piston."""
         n = len(arrays.get("order", ()))
         if version == 1:
             arrays = {**arrays, "resting": np.zeros(n, dtype=np.int64), "last_collision": np.full(n, -np.inf)}
@@ -143,6 +150,9 @@ class EventDrivenState(EngineState):
         if version == 3:
             arrays = {**arrays, "sensed": np.zeros((n, 0), dtype=np.int64)}
             scalars = {**scalars, "sensor_events": 0}
+            version = 4
+        if version == 4:
+            arrays = {**arrays, "piston": np.zeros(0)}
             version = cls.VERSION
         return super().from_arrays(scalars, arrays, version)
 
@@ -217,8 +227,11 @@ class EventDrivenState(EngineState):
             fail("queue_owner", "at most one pending event per disc")
         if ((self.queue_owner < 0) | (self.queue_owner >= n)).any():
             fail("queue_owner", f"disc indices must lie in [0, {n})")
-        if ((self.queue_kind < 0) | ((self.queue_kind > 3) & (self.queue_kind != 7))).any():
-            fail("queue_kind", "kinds are 0 (collision), 1 (wall), 2 (crossing), 3 (segment) and 7 (sensor)")
+        if ((self.queue_kind < 0) | ((self.queue_kind > 3) & (self.queue_kind != 7) & (self.queue_kind != 10))).any():
+            fail("queue_kind", "kinds are 0 (collision), 1 (wall), 2 (crossing), 3 (segment), 7 (sensor), 10 (piston)")
+        piston = self.piston
+        if not isinstance(piston, np.ndarray) or piston.shape not in ((0,), (5,)) or not np.isfinite(piston).all():
+            fail("piston", f"expected 5 finite numbers or none, got {piston!r}")
         sensed = self.sensed
         if not isinstance(sensed, np.ndarray) or sensed.ndim != 2 or len(sensed) != n or sensed.dtype.kind != "i":
             got = f"{sensed.dtype} {sensed.shape}" if isinstance(sensed, np.ndarray) else type(sensed).__name__

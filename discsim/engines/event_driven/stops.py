@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from discsim.cells import neighbour_pairs
+from discsim.engines.event_driven.piston import check_room
 from discsim.engines.event_driven.protocol import Backend
 from discsim.errors import Interrupted, InvalidArgumentError, JammedError
 from discsim.model import Box, Discs
@@ -38,6 +39,29 @@ def check_parts(scene: Scene, laws) -> None:
             f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
         )
         raise InvalidArgumentError(msg)
+    if scene.piston is not None:
+        check_piston(scene, laws)
+
+
+def check_piston(scene: Scene, laws) -> None:
+    """Refuse, by name, a piston with what it does not take yet (laws other than the defaults, obstacles, moving
+    segments), a piston of finite mass over no disc, and one the gas could lift out of the box (:func:`check_room`)."""
+    piston, discs = scene.piston, scene.discs
+    if not laws.default:
+        msg = f"a piston runs under the default laws (elastic, smooth, no gravity or drag) only, not {laws!r}"
+        raise InvalidArgumentError(msg)
+    if scene.moving:
+        k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
+        msg = f"segments[{k}] moves: a piston and moving segments do not run together yet"
+        raise InvalidArgumentError(msg)
+    fixed = np.flatnonzero(discs.masses == INF)
+    if len(fixed):
+        msg = f"disc {int(fixed[0])} is an obstacle (infinite mass): a piston does not run with obstacles yet"
+        raise InvalidArgumentError(msg)
+    if not piston.kinematic and not len(discs):
+        msg = "a piston of finite mass needs discs under it (it would fall for ever)"
+        raise InvalidArgumentError(msg)
+    check_room(piston, scene.box, discs, scene.piston_height, piston.velocity, piston.pressure)
 
 
 class RunStops:
@@ -112,12 +136,11 @@ class RunStops:
     def _moved_segments(self, segments: tuple) -> None:
         """The segments from now on are ``segments`` (one's velocity changed, where it is now): the backend starts
         afresh here from the discs as they are (as :meth:`_rewind` does), over the new segments. O(N)."""
-        scene = self.scene
-        scene = Scene(scene.discs, self.box, segments, scene.pass_through, sensors=scene.sensors, check=False)
+        scene = self.scene.but(segments=segments)
         check_parts(scene, self.laws)  # before anything changes
         last = self._backend.last_event()
         now = self.snapshot()
-        here = Scene(now, self.box, segments, scene.pass_through, sensors=scene.sensors, check=False)
+        here = scene.but(now)
         self._restructure(np.arange(len(now)), None, here, last)
         self.scene, self.segments = scene, scene.segments
 
@@ -134,9 +157,7 @@ class RunStops:
         last = old.last_event()
         old.time = time
         now = self.snapshot()
-        scene = Scene(
-            now, self.box, self.scene.segments, self.scene.pass_through, sensors=self.scene.sensors, check=False
-        )
+        scene = self.scene.but(now)
         self._restructure(np.arange(len(now)), None, scene, last)
 
     #: A run raises :class:`~discsim.errors.JammedError` after ``jam_events + jam_events_per_disc * N``

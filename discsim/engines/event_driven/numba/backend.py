@@ -29,9 +29,6 @@ __all__ = ["NumbaBackend"]
 
 #: Queue pops per call of the compiled loop: how soon Ctrl-C is seen (about 10-50 ms of work).
 BUDGET = 1 << 16
-#: Rows of the buffer the compiled loop writes the event log into, per call (0.1 MB: a streamed run's
-#: memory stays flat and small).
-LOG_ROWS = 1 << 10
 # Physical events between moves of the internal clock's epoch (as the Python backend).
 _REBASE_EVENTS = 1 << 18
 _COLLISION = int(EventKind.COLLISION)
@@ -42,6 +39,13 @@ def _loop():
     from discsim.engines.event_driven.numba import loop
 
     return loop
+
+
+def _moving():
+    """The compiled piston's layout (:mod:`~discsim.engines.event_driven.numba.moving`)."""
+    from discsim.engines.event_driven.numba import moving
+
+    return moving
 
 
 def _variants():
@@ -108,8 +112,8 @@ class NumbaBackend(CompiledReads):
         self._rebase_every = max(_REBASE_EVENTS, 16 * len(scene))
         self._lp = _loop()
         self._law_of_motion = law_of_motion or dynamics
-        if not self.laws.default or scene.sensors or scene.moving:  # the loop that reads the laws (one for every
-            # value of them), the sensors and moving segments
+        if not self.laws.default or scene.sensors or scene.moving or scene.piston is not None:  # the loop that
+            # reads the laws (one for every value of them), the sensors, moving segments and the piston
             self._lp = SimpleNamespace(**_variants().with_laws(interpreted=interpreted))
         elif law_of_motion is not None or collision_law is not None or interpreted:
             variants = _variants()
@@ -119,8 +123,9 @@ class NumbaBackend(CompiledReads):
         box = self.box
         nx, ny = grid.nx, grid.ny
         # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides
-        # and the box's height, then the laws' numbers (one array: a compiled call passes each array as seven
-        # words, and a call of more than 30 arguments cannot be inlined: CPython passes them as a tuple).
+        # and the box's height, then the laws' numbers, then the piston's if there is one (moving.SLOTS; one array:
+        # a compiled call passes each array as seven words, and a call of more than 30 arguments cannot be inlined:
+        # CPython passes them as a tuple).
         self._edges = np.concatenate(
             [
                 np.arange(nx) * grid.lx,
@@ -128,6 +133,7 @@ class NumbaBackend(CompiledReads):
                 np.arange(ny) * grid.ly,
                 [box.height],
                 self.laws.array(scene.discs.radii),
+                np.zeros(0 if scene.piston is None else _moving().SLOTS),
             ]
         )
         # The segments' rows (end points now, shape code 0, -, velocity, end points at time 0), then the sensors'
@@ -250,6 +256,8 @@ class NumbaBackend(CompiledReads):
         seg[moving, 0:2] = seg[moving, 8:10] + seg[moving, 6:8] * state.epoch
         seg[moving, 2:4] = seg[moving, 10:12] + seg[moving, 6:8] * state.epoch
         self._tlast = state.last_collision[order].astype(np.float64)
+        if self.scene.piston is not None:  # its numbers, last in edges
+            _moving().put(self._edges, self.scene.piston.mass, state.piston, self.box.width)
         self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
         self._rot = np.column_stack(
@@ -330,6 +338,7 @@ class NumbaBackend(CompiledReads):
             sensor_events=int(ints[lp.I_SENSE]),
             spins=spins,
             angles=angles,
+            piston=_moving().numbers(self._edges) if self.scene.piston is not None else np.zeros(0),
         )
 
     def advance(self, until: float, limit: int | None, log: EventLog | None, crossings: int | None = None) -> int:
@@ -382,11 +391,6 @@ class NumbaBackend(CompiledReads):
                         break
             if not interrupted[0]:
                 return done
-
-    def _log_rows(self) -> int:
-        """Rows of the loop's log buffer: :data:`LOG_ROWS`, and under gravity room for every disc besides (an
-        event that wakes a pile logs a ``SET`` record for each disc that falls again)."""
-        return LOG_ROWS + (len(self._rec) if self.laws.falls else 0)
 
     def set_disc(self, i: int, vx: float, vy: float, position: tuple[float, float] | None = None) -> None:
         """As :meth:`discsim.engines.event_driven.python.PythonBackend.set_disc`: restart moving disc ``i``'s

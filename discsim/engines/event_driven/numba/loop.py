@@ -33,10 +33,10 @@ import math
 import numpy as np
 
 from discsim._compiled import inline, jit
-from discsim.engines.event_driven.numba import blocks
+from discsim.engines.event_driven.numba import blocks, moving
 from discsim.engines.event_driven.numba.blocks import BLOCK, BLOCK_SHIFT, discard, push, reblock  # noqa: F401
 from discsim.engines.event_driven.numba.cells import _enter, _leave, link, unlink  # noqa: F401
-from discsim.engines.event_driven.numba.sensing import place_segments, resense, sense
+from discsim.engines.event_driven.numba.sensing import resense, sense
 from discsim.engines.event_driven.numba.support import (  # noqa: F401
     ANGLE,
     ANGLE_T,
@@ -60,7 +60,7 @@ from discsim.engines.event_driven.numba.support import (  # noqa: F401
     turn,
 )
 from discsim.events import EventKind
-from discsim.laws import BETA, DRAG, GX, GY, REST_SPEED, TC
+from discsim.laws import BETA, DRAG, GX, GY, LAW_SLOTS, REST_SPEED, TC
 from discsim.physics.compiled import (
     advance,
     closest_point_on_segment,
@@ -82,7 +82,7 @@ INF = math.inf
 COLLISION, WALL, CROSSING, SEGMENT, SET = (
     int(k) for k in (EventKind.COLLISION, EventKind.WALL, EventKind.CROSSING, EventKind.SEGMENT, EventKind.SET)
 )
-SENSOR = int(EventKind.SENSOR)
+SENSOR, PISTON = int(EventKind.SENSOR), int(EventKind.PISTON)
 # Slots of ``ints``.
 I_PRED, I_COLL, I_WALL, I_CROSS, I_STALE, I_SINCE, I_MAXQ, I_SIZE, I_LKIND, I_LI, I_LJ, I_RESTS, I_SENSE = range(13)
 N_INTS = 13
@@ -235,6 +235,11 @@ def predict(
                 )
             if ts < best:
                 best, kind, other = ts, SEGMENT, k
+    stamp = 0
+    if LAWS and edges.shape[0] > nx + ny + 2 + LAW_SLOTS:  # the piston above (its numbers last): when i meets it
+        ts = moving.time(yi, vyi, ri, t, edges)
+        if ts < best:
+            best, kind, other, stamp = ts, PISTON, -1, int(edges[edges.shape[0] - moving.SLOTS + moving.P_HITS])
     if best < 0.0:
         best = 0.0
     # 3. Schedule the earlier of the two.
@@ -244,7 +249,7 @@ def predict(
     elif best == INF:
         discard(i, qt, bheap, bht, bpos, barg, ints)
     else:
-        push(i, t_best, kind, other, 0, qt, bheap, bht, bpos, barg, qk, qo, qs, ints)
+        push(i, t_best, kind, other, stamp, qt, bheap, bht, bpos, barg, qk, qo, qs, ints)
 
 
 @jit
@@ -299,20 +304,6 @@ def set_disc(
 
 
 # --- the hot loop --------------------------------------------------------------------------------------
-@jit
-def rebase(shift, rec, qt, bheap, bht, bpos, barg, floats, seg):
-    """Move the internal clock's origin forward by ``shift``, as the Python backend's ``_rebase``; a moving
-    segment's row holds where it is at the new origin (from where it was at time 0: the same at every rebase)."""
-    place_segments(seg, floats[F_EPOCH] + shift)
-    for i in range(rec.shape[0]):
-        rec[i, T] -= shift
-        rec[i, KEPT] = rec[i, KEPT] - shift
-    for i in range(qt.shape[0]):
-        qt[i] = qt[i] - shift  # inf stays inf
-    reblock(qt, bheap, bht, bpos, barg)  # the shift may round two times to one: order them anew
-    floats[F_EPOCH] += shift
-
-
 @jit
 def run_events(
     until, limit, crossings, budget, rebase_every, recording,
@@ -620,17 +611,23 @@ def run_events(
                 qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
             )  # fmt: skip
             last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
-        elif LAWS and kind == SENSOR:  # i's centre changes sides of the sensor of row ``other``: the path goes on
-            sensed = sense(
-                i, t, other, epoch, gravity, gx, gy, drag, rough, recording, logged, rec, rest, seg, order, rot,
-                ev_t, ev_kind, ev_i, ev_j, ev_f, ev_w,
-            )  # fmt: skip
-            if sensed >= 0:  # (not beyond a trip wire's ends)
-                n_sense += 1
-                done += 1
-                if recording:
-                    logged += 1
-                last_time, last_kind, last_i, last_j = t + epoch, sensed, i, int(seg[other, 5])
+        elif LAWS and (kind == PISTON or kind == SENSOR):  # i meets the piston (unless it was hit since the
+            # prediction: its path is higher now) or changes sides of the sensor of row ``other`` (the path goes on)
+            if kind == PISTON and qs[i] != int(edges[edges.shape[0] - moving.SLOTS + moving.P_HITS]):
+                n_stale += 1
+            elif kind == PISTON:
+                moving.hit(i, t, epoch, recording, logged, rec, edges, order, ev_t, ev_kind, ev_i, ev_j, ev_f)
+                count[i] += 1
+                n_wall, done, logged = n_wall + 1, done + 1, logged + (1 if recording else 0)
+                last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1
+            else:
+                sensed = sense(
+                    i, t, other, epoch, gravity, gx, gy, drag, rough, recording, logged, rec, rest, seg, order, rot,
+                    ev_t, ev_kind, ev_i, ev_j, ev_f, ev_w,
+                )  # fmt: skip
+                if sensed >= 0:  # (not beyond a trip wire's ends)
+                    n_sense, done, logged = n_sense + 1, done + 1, logged + (1 if recording else 0)
+                    last_time, last_kind, last_i, last_j = t + epoch, sensed, i, int(seg[other, 5])
             predict(
                 i, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
                 nx, ny, periodic, edges,
@@ -668,7 +665,8 @@ def run_events(
         now = t
         have_now = True
         if done >= rebase_at:
-            rebase(now, rec, qt, bheap, bht, bpos, barg, floats, seg)
+            moving.rebase(now, epoch, rec, qt, bheap, bht, bpos, barg, seg, edges, nx + ny + 2 + LAW_SLOTS)
+            floats[F_EPOCH] += now
             epoch = floats[F_EPOCH]
             now = 0.0
             horizon = until - epoch

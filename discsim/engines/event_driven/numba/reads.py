@@ -11,8 +11,13 @@ import numpy as np
 
 from discsim.events import SENSED
 from discsim.physics.dynamics import advance_many
+from discsim.physics.sources import piston
 
-__all__ = ["CompiledReads"]
+__all__ = ["LOG_ROWS", "CompiledReads"]
+
+#: Rows of the buffer the compiled loop writes the event log into, per call (0.1 MB: a streamed run's
+#: memory stays flat and small).
+LOG_ROWS = 1 << 10
 
 
 class CompiledReads:
@@ -46,12 +51,28 @@ class CompiledReads:
     _tlast: np.ndarray
     _found: np.ndarray
     _egroup: np.ndarray
+    _edges: np.ndarray
     _law_of_motion: Any
     laws: Any
     box: Any
     grid: Any
 
     # --- cheap reads -----------------------------------------------------------------------
+    def _log_rows(self) -> int:
+        """Rows of the loop's log buffer: :data:`LOG_ROWS`, and under gravity room for every disc besides (an
+        event that wakes a pile logs a ``SET`` record for each disc that falls again)."""
+        return LOG_ROWS + (len(self._rec) if self.laws.falls else 0)
+
+    def piston_now(self) -> tuple[float, float, int, float]:
+        """The piston's height and velocity now, its impacts so far and its pressure (a piston run only)."""
+        from discsim.engines.event_driven.numba import moving  # (compiled: imported with the loop)
+
+        height, velocity, ref_time, hits, pressure = (float(v) for v in moving.numbers(self._edges))
+        accel = float(self._edges[len(self._edges) - moving.SLOTS + moving.P_ACCEL])
+        since = self.time - float(self._floats[self._lp.F_EPOCH]) - ref_time
+        height, velocity = piston.at(height, velocity, accel, since)
+        return height, velocity, int(hits), pressure
+
     @property
     def time(self) -> float:
         return float(self._floats[self._lp.F_TIME])

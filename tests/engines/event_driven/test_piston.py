@@ -1,0 +1,154 @@
+"""A piston on top of the box (issue 28, item 2): closed forms, an independent 1D oracle of a disc bouncing under it,
+energy, checkpoints, set_piston, both backends bit for bit, a kinematic lid, bad input."""
+
+import math
+
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim.errors import InvalidArgumentError, OutsideBoxError, WrongTypeError
+
+BOX = ds.Box(10.0, 10.0)
+
+
+def ball(x, y, vx=0.0, vy=0.0, r=0.5, m=1.0):
+    return ds.Discs([[x, y]], [[vx, vy]], radii=r, masses=m)
+
+
+def energy(sim):
+    """The run's invariant: the discs' kinetic energy, the piston's, and its potential energy F H."""
+    p = sim.piston
+    return sim.kinetic_energy() + 0.5 * p.mass * p.velocity**2 + p.pressure * sim.box.width * p.height
+
+
+def test_a_piston_released_over_a_disc_at_rest_falls_onto_it_and_they_bounce_as_two_masses_do():
+    # M = 3 under F = 0.3 * 10: a = 1; the gap 5.5 - 0.5 - 1 = 4 closes at sqrt(2 * 4 / 1); at -sqrt(8) it hits m = 1
+    # at rest: the disc leaves at 2 M u / (m + M), the piston goes on at (M - m) u / (m + M).
+    sim = ds.EventDriven(ball(5.0, 1.0), BOX, piston=ds.Piston(mass=3.0, pressure=0.3, height=5.5))
+    event = sim.step()
+    u = -math.sqrt(8.0)
+    assert (event.kind, event.i, event.j) == ("wall", 0, -1)
+    assert event.time == pytest.approx(math.sqrt(8.0), rel=1e-14)
+    assert sim.velocities[0] == pytest.approx([0.0, 1.5 * u], rel=1e-14)
+    assert sim.piston.velocity == pytest.approx(0.5 * u, rel=1e-14)
+    assert sim.piston.height == pytest.approx(1.5, rel=1e-14) and sim.piston.hits == 1
+    record = sim.events[-1]  # the log's WALL record carries the piston's height and velocity after
+    assert (record["yj"], record["vyj"]) == (sim.piston.height, sim.piston.velocity)
+    assert np.isnan(record["xj"]) and np.isnan(record["vxj"])
+
+
+def _oracle(y, v, r, m, h, u, mass, force, until):
+    """An independent 1D event loop of one disc bouncing between the floor and a piston (both of which it meets
+    exactly): the list of (time, y, v, h, u) after each impact on the piston."""
+    a = force / mass
+    t, out = 0.0, []
+    while True:
+        # the floor: y - r + v s = 0 for v < 0; the piston: (h - r - y) + (u - v) s - a s^2 / 2 = 0, larger root
+        floor = (r - y) / v if v < 0 else math.inf
+        g, w = h - r - y, u - v
+        top = (w + math.sqrt(w * w + 2.0 * a * g)) / a
+        s = min(floor, top)
+        if t + s > until:
+            return out
+        t += s
+        y, h, u = y + v * s, h + u * s - 0.5 * a * s * s, u - a * s
+        if s == floor:
+            v = -v
+        else:
+            v, u = ((m - mass) * v + 2 * mass * u) / (m + mass), ((mass - m) * u + 2 * m * v) / (m + mass)
+            out.append((t, y, v, h, u))
+
+
+def test_a_disc_under_a_piston_bounces_as_an_independent_1d_loop_says_and_the_energy_holds():
+    disc = ball(3.0, 2.0, 0.0, 1.3, r=0.5, m=1.0)
+    piston = ds.Piston(mass=4.0, pressure=0.2, height=6.0, velocity=0.5)
+    sim = ds.EventDriven(disc, BOX, piston=piston).run(until=60.0)
+    hits = sim.events[(sim.events["kind"] == int(ds.EventKind.WALL)) & ~np.isnan(sim.events["yj"])]
+    expected = np.array(_oracle(2.0, 1.3, 0.5, 1.0, 6.0, 0.5, 4.0, 0.2 * 10.0, 60.0))
+    assert len(hits) == len(expected) > 10
+    got = np.column_stack([hits["time"], hits["yi"], hits["vyi"], hits["yj"], hits["vyj"]])
+    assert got == pytest.approx(expected, rel=1e-9, abs=1e-9)
+    assert energy(sim) == pytest.approx(0.5 * 1.3**2 + 0.5 * 4.0 * 0.25 + 2.0 * 6.0, rel=1e-13)
+
+
+def test_a_gas_under_a_piston_keeps_its_energy_and_every_disc_below_it():
+    discs, _ = ds.random_gas(40, 0.2, seed=3, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 2.0, 200.0)  # tall enough for the energy bound
+    top = float((discs.positions[:, 1] + discs.radii).max()) + 0.5
+    sim = ds.EventDriven(discs, box, piston=ds.Piston(mass=20.0, pressure=0.5, height=top))
+    e0 = energy(sim)
+    for until in np.linspace(1.0, 20.0, 5):
+        sim.run(until=until)
+        assert energy(sim) == pytest.approx(e0, rel=1e-12)
+        assert (sim.positions[:, 1] + sim.discs.radii <= sim.piston.height * (1 + 1e-12)).all()
+    assert sim.piston.hits > 20 and sim.counts["stale"] > 0  # contacts dropped after another disc hit it first
+    sim._check()
+
+
+def test_a_piston_run_resumes_from_a_checkpoint_bit_for_bit_and_both_backends_agree(every_backend, tmp_path):
+    discs, _ = ds.random_gas(20, 0.2, seed=4, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 2.0, 100.0)
+    piston = ds.Piston(mass=5.0, pressure=0.4, height=float((discs.positions[:, 1] + discs.radii).max()) + 1.0)
+    whole = ds.EventDriven(discs, box, piston=piston).run(until=8.0)
+    assert whole.backend == every_backend
+    half = ds.EventDriven(discs, box, piston=piston).run(until=4.0)
+    half.save(tmp_path / "half.npz")
+    resumed = ds.load(tmp_path / "half.npz")
+    assert resumed.scene.piston == piston
+    resumed.run(until=8.0)
+    assert resumed.events.tobytes() == whole.events.tobytes()
+    assert resumed.piston.height == whole.piston.height
+    if every_backend == "numba":
+        python = ds.EventDriven(discs, box, piston=piston, backend="python").run(until=8.0)
+        assert python.events.tobytes() == whole.events.tobytes()
+
+
+def test_set_piston_pushes_harder_from_now_on():
+    sim = ds.EventDriven(ball(5.0, 1.0, 0.0, 2.0), BOX, piston=ds.Piston(mass=2.0, pressure=0.1, height=4.0))
+    sim.run(until=5.0)
+    sim.set_piston(pressure=0.4)
+    assert sim.piston.pressure == 0.4
+    e0 = energy(sim)
+    sim.run(until=30.0)
+    assert energy(sim) == pytest.approx(e0, rel=1e-12)
+    sim.set_piston(velocity=0.0)
+    assert sim.piston.velocity == 0.0
+
+
+def test_a_kinematic_lid_closes_on_a_disc_at_its_speed():
+    # The lid y = 8 - t; the disc rises at 1 from y = 2 (top 2.5): they meet at t = 2.75, the disc leaves at 2u - v.
+    lid = ds.Piston(mass=math.inf, pressure=0.0, height=8.0, velocity=-1.0)
+    sim = ds.EventDriven(ball(5.0, 2.0, 0.0, 1.0), BOX, piston=lid)
+    event = sim.step()
+    assert event.time == pytest.approx(2.75, rel=1e-14)
+    assert sim.velocities[0] == pytest.approx([0.0, -3.0], rel=1e-14)
+    assert sim.piston.velocity == -1.0 and sim.piston.height == pytest.approx(5.25, rel=1e-14)
+
+
+def test_bad_pistons_are_refused_by_name_before_anything_runs():
+    disc = ball(5.0, 1.0)
+    with pytest.raises(InvalidArgumentError, match="mass"):
+        ds.Piston(mass=0.0, pressure=1.0)
+    with pytest.raises(InvalidArgumentError, match="pressure"):
+        ds.Piston(mass=1.0, pressure=0.0)
+    with pytest.raises(InvalidArgumentError, match="kinematic"):
+        ds.Piston(mass=math.inf, pressure=1.0)
+    with pytest.raises(WrongTypeError, match="piston"):
+        ds.EventDriven(disc, BOX, piston="heavy")
+    with pytest.raises(InvalidArgumentError, match="periodic"):
+        ds.EventDriven(disc, ds.Box(10.0, 10.0, periodic=True), piston=ds.Piston(1.0, 1.0))
+    with pytest.raises(OutsideBoxError, match="disc 0"):
+        ds.EventDriven(disc, BOX, piston=ds.Piston(1.0, 1.0, height=1.2))
+    with pytest.raises(InvalidArgumentError, match="above the box"):
+        ds.EventDriven(ball(5.0, 1.0, 0.0, 5.0), BOX, piston=ds.Piston(1.0, 0.01, height=5.0))
+    with pytest.raises(InvalidArgumentError, match="default laws"):
+        ds.EventDriven(disc, BOX, piston=ds.Piston(1.0, 1.0), restitution=0.5)
+    with pytest.raises(InvalidArgumentError, match="obstacle"):
+        ds.EventDriven(ball(5.0, 1.0, m=math.inf), BOX, piston=ds.Piston(1.0, 1.0))
+    sim = ds.EventDriven(ball(5.0, 1.0, 0.0, 1.0), BOX, piston=ds.Piston(1.0, 1.0, height=5.0))
+    with pytest.raises(InvalidArgumentError, match="above the box"):
+        sim.set_piston(pressure=1e-6)
+    with pytest.raises(InvalidArgumentError, match="needs a piston"):
+        ds.EventDriven(disc, BOX).set_piston(pressure=1.0)
+    assert sim.piston.pressure == 1.0 and sim.time == 0.0

@@ -321,7 +321,9 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
             over that many batches (the error bars of earlier versions).
 
     Returns:
-        :class:`ThermoAverages`.
+        :class:`ThermoAverages`; for a run at constant pressure (a :class:`discsim.Piston`), the
+        :class:`~discsim.analysis.isobaric.IsobaricAverages` of :func:`~discsim.analysis.isobaric.isobaric`: the
+        mean area, packing fraction and ``Z`` with their error bars.
 
     Warns:
         EquilibrationWarning: if the production series still drifts (Geweke's score beyond 3), holds fewer than
@@ -340,6 +342,10 @@ def thermo(source, since: float | str | None = None, blocks: int | None = None) 
         >>> bool(abs(t.z - ds.henderson_z(0.3)) < 5 * t.z_err + 0.05), t.since, t.method, t.drifting
         (True, 1.0, 'statistical inefficiency', False)
     """
+    if getattr(getattr(source, "scene", None), "piston", None) is not None and blocks is None:
+        from discsim.analysis.isobaric import isobaric  # a run at constant pressure: its area fluctuates
+
+        return isobaric(source, since)  # type: ignore[return-value]
     if blocks is not None and (not is_count(blocks) or blocks < 2):
         msg = f"blocks must be None or an integer >= 2 (batches of the error bar), got {blocks!r}"
         raise InvalidArgumentError(msg)

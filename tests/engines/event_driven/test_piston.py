@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import discsim as ds
-from discsim.errors import InvalidArgumentError, OutsideBoxError, WrongTypeError
+from discsim.analysis.isobaric import IsobaricAverages
+from discsim.errors import InvalidArgumentError, OutsideBoxError, TimeError, WrongTypeError
 
 BOX = ds.Box(10.0, 10.0)
 
@@ -152,3 +153,28 @@ def test_bad_pistons_are_refused_by_name_before_anything_runs():
     with pytest.raises(InvalidArgumentError, match="needs a piston"):
         ds.EventDriven(disc, BOX).set_piston(pressure=1.0)
     assert sim.piston.pressure == 1.0 and sim.time == 0.0
+
+
+def test_thermo_of_a_piston_run_averages_the_area_it_sampled_and_says_the_pressure():
+    discs, _ = ds.random_gas(30, 0.3, seed=6, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 1.5, 120.0)
+    top = float((discs.positions[:, 1] + discs.radii).max()) + 0.5
+    sim = ds.EventDriven(discs, box, piston=ds.Piston(mass=8.0, pressure=0.3, height=top))
+    sim.run(until=5.0)
+    heights, kinetic = [], []
+    for t in np.linspace(5.0, 40.0, 7001)[1:]:  # a dense sample of the piston's height and the discs' energy
+        sim.run(until=t)
+        heights.append(sim.piston.height)
+        kinetic.append(sim.kinetic_energy())
+    averages = ds.thermo(sim, since=5.0)
+    assert isinstance(averages, IsobaricAverages) and averages.pressure == 0.3
+    assert averages.area == pytest.approx(box.width * np.mean(heights), rel=5e-4)
+    assert averages.energy == pytest.approx(np.mean(kinetic), rel=5e-4)
+    assert averages.z == pytest.approx(0.3 * averages.area / averages.energy, rel=1e-12)
+    assert averages.packing == pytest.approx(np.pi * np.sum(discs.radii**2) / averages.area, rel=1e-12)
+    assert 0 < averages.area_err < 0.05 * averages.area
+    sim.set_piston(pressure=0.5)
+    sim.run(until=50.0)
+    with pytest.raises(TimeError, match="last change"):
+        ds.thermo(sim, since=30.0)
+    assert ds.thermo(sim).pressure == 0.5

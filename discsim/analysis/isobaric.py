@@ -117,7 +117,7 @@ def isobaric(sim, since: float | str | None = None) -> IsobaricAverages:
     # Where the path from each impact puts the piston at the next: a mismatch is a change (set_piston); edits of the
     # discs change their energy: the log is followed from the last of either.
     gap = t[1:] - t[:-1]
-    reached, u_before = at(h[:-1], u[:-1], accel, gap)
+    reached, u_before = at(h[:-1], u[:-1], accel, gap)  # type: ignore[arg-type]  # (elementwise)
     broken = np.flatnonzero(~np.isclose(reached, h[1:], rtol=1e-9, atol=1e-12 * (1.0 + abs(h).max())))
     start = float(t[broken[-1] + 1]) if len(broken) else float(t[0])
     edited = events["time"][np.isin(events["kind"], (SET, ADD, REMOVE))]

@@ -20,7 +20,7 @@ def test_quick_mode_writes_a_row_per_backend_and_law(tmp_path):
     with open(tmp_path / "laws.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     laws = {"elastic", "gravity", "restitution", "gravity+restitution", "rough", "perfectly rough"}
-    laws |= {"drag", "gravity+drag", "sensors", "moving segment"}
+    laws |= {"drag", "gravity+drag", "sensors", "moving segment", "piston"}
     assert {row["law"] for row in rows} == laws
     for row in rows:
         assert float(row["collisions_per_s"]) > 0

@@ -17,7 +17,7 @@ def top_wall_z(sim, since):
     """``Z = P A / K`` at fixed volume, ``P`` the momentum the discs give the box's top wall per unit time and
     length (every top-wall bounce gives ``2 m |vy|``), with a batch-means error bar."""
     ev = sim.events
-    r, height, width = sim.discs.radii, sim.box.height, sim.box.width
+    r, height = sim.discs.radii, sim.box.height
     top = (ev["kind"] == int(ds.EventKind.WALL)) & (ev["yi"] > height - r[ev["i"]] - 1e-9) & (ev["vyi"] < 0)
     hits = ev[top & (ev["time"] > since)]
     impulse = 2.0 * np.abs(hits["vyi"]) * sim.discs.masses[hits["i"]]

@@ -21,7 +21,7 @@ def check(sim) -> None:
     - each disc has at most one pending event, none in the past, and a moving disc has one; the queue
       holds at most N events;
     - collision events name a partner, kept collisions a valid partner;
-    - the discs fit in the box without overlap (as the constructor checks).
+    - the discs fit in the box without overlap (as the constructor checks), and under the piston if there is one.
 
     Raises:
         AssertionError, or CheckpointError from :meth:`EventDrivenState.check` for the state's own form.
@@ -60,3 +60,7 @@ def check(sim) -> None:
     assert not idle.any(), f"moving disc {np.flatnonzero(idle)[0]} has no pending event"
     d = sim.discs
     check_fits(Discs(sim.positions, sim.velocities, d.radii, d.masses, d.groups), box, pass_through=sim.pass_through)
+    piston = sim.piston
+    if piston is not None and n:
+        top = sim.positions[:, 1] + d.radii
+        assert top.max() <= piston.height + 1e-9 * box.height, f"disc {int(top.argmax())} is above the piston"

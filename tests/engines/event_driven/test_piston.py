@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import discsim as ds
 from discsim.analysis.isobaric import IsobaricAverages
@@ -178,3 +180,33 @@ def test_thermo_of_a_piston_run_averages_the_area_it_sampled_and_says_the_pressu
     with pytest.raises(TimeError, match="last change"):
         ds.thermo(sim, since=30.0)
     assert ds.thermo(sim).pressure == 0.5
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    n=st.integers(1, 12),
+    mass=st.floats(0.05, 50.0),
+    pressure=st.floats(0.01, 2.0),
+    velocity=st.floats(-3.0, 3.0),
+)
+def test_any_small_gas_under_any_piston_keeps_its_energy_and_stays_below_it(seed, n, mass, pressure, velocity):
+    rng = np.random.default_rng(seed)
+    discs = ds.Discs(
+        np.column_stack([1.0 + 8.0 * (np.arange(n) % 4) / 3.0, 1.0 + 1.2 * (np.arange(n) // 4)]),
+        rng.normal(size=(n, 2)),
+        radii=0.5,
+        masses=rng.uniform(0.5, 2.0, n),
+    )
+    start = energy_of(discs, mass, pressure, 10.0, 6.0, velocity)
+    box = ds.Box(10.0, max(6.0 + start / (pressure * 10.0), 7.0) * 1.01)  # above the energy bound
+    sim = ds.EventDriven(discs, box, piston=ds.Piston(mass, pressure, height=6.0, velocity=velocity))
+    sim.run(events=300)
+    assert energy(sim) == pytest.approx(start, rel=1e-10)
+    sim._check()
+
+
+def energy_of(discs, mass, pressure, width, height, velocity):
+    """The energy above the floor's potential: the discs' kinetic energy, the piston's, and F H."""
+    kinetic = 0.5 * float(np.sum(discs.masses * np.sum(discs.velocities**2, axis=1)))
+    return kinetic + 0.5 * mass * velocity**2 + pressure * width * height

@@ -30,13 +30,16 @@ INF = math.inf
 
 
 def check_parts(scene: Scene, laws) -> None:
-    """Refuse, by name, the moving segments the loop does not time yet under ``laws`` (a
-    :class:`~discsim.laws.Laws`)."""
-    if scene.moving and (laws.falls or laws.drag or laws.rough):
+    """Refuse, by name, what the loop does not run yet under ``laws`` (a :class:`~discsim.laws.Laws`): moving
+    segments under gravity with restitution below 1 (a disc settling on a moving support would need to rest in its
+    frame), and a piston with what it does not take (:func:`check_piston`)."""
+    elastic = laws.restitution == 1.0 and not laws._pairs
+    if scene.moving and laws.falls and not elastic:
         k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
         msg = (
-            f"segments[{k}] {scene.segments[k]!r} moves: moving segments run under the default laws or "
-            f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
+            f"segments[{k}] {scene.segments[k]!r} moves: under gravity={laws.gravity} moving segments run with "
+            f"elastic bounces only (restitution=1), not restitution={laws.restitution!r} (a disc would settle on "
+            "the moving segment, and rest in its frame is not built yet)"
         )
         raise InvalidArgumentError(msg)
     if scene.piston is not None:

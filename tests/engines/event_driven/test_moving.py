@@ -115,7 +115,9 @@ def test_queries_and_added_discs_see_the_segment_where_it_is_now():
     [
         (lambda: ds.Segment((0, 0), (1, 1), velocity=(float("nan"), 0.0)), InvalidDiscsError, "velocity"),
         (
-            lambda: ds.EventDriven(ball(2, 2), BOX, segments=[ds.Segment((5, 0), (5, 9), (1, 0))], gravity=(0, -1)),
+            lambda: ds.EventDriven(
+                ball(2, 2), BOX, segments=[ds.Segment((5, 0), (5, 9), (1, 0))], gravity=(0, -1), restitution=0.8
+            ),
             InvalidArgumentError,
             "segments[0]",
         ),
@@ -160,7 +162,9 @@ def test_a_paddle_steered_mid_run_stays_where_it_is_and_moves_on_at_its_new_velo
 
 
 def test_steering_a_segment_is_refused_by_name_and_changes_nothing():
-    sim = ds.EventDriven(ball(2.0, 5.0), BOX, segments=[ds.Segment((8.0, 3.0), (8.0, 7.0))], gravity=(0.0, -1.0))
+    sim = ds.EventDriven(
+        ball(2.0, 5.0), BOX, segments=[ds.Segment((8.0, 3.0), (8.0, 7.0))], gravity=(0.0, -1.0), restitution=0.8
+    )
     with pytest.raises(InvalidArgumentError, match="segments\\[0\\]"):
         sim.set_segment_velocity(0, (1.0, 0.0))
     assert not sim.segments[0].moving
@@ -170,3 +174,83 @@ def test_steering_a_segment_is_refused_by_name_and_changes_nothing():
         sim.set_segment_velocity(0, (float("inf"), 0.0))
     with pytest.raises(InvalidArgumentError, match="FixedStep cannot change a segment"):
         ds.FixedStep(ball(2.0, 5.0), BOX, segments=[ds.Segment((8.0, 3.0), (8.0, 7.0))]).set_segment_velocity(0, (1, 0))
+
+
+def test_under_gravity_a_ball_on_a_conveyor_bounces_as_on_a_fixed_floor_seen_from_the_belt():
+    # Galilean invariance with gravity: the belt y = 2 moving at u = 0.5 along x; in its frame the ball bounces as on
+    # a fixed floor with its velocity less u (straight up and down here): the same times, velocities differing by u.
+    g = (0.0, -2.0)
+    belt = ds.Segment((-5.0, 2.0), (15.0, 2.0), velocity=(0.5, 0.0))
+    moving = ds.EventDriven(ball(3.0, 5.0, 0.5, 0.0), ds.Box(12.0, 10.0), segments=[belt], gravity=g)
+    fixed = ds.EventDriven(
+        ball(3.0, 5.0, 0.0, 0.0), ds.Box(12.0, 10.0), segments=[ds.Segment((-5.0, 2.0), (15.0, 2.0))], gravity=g
+    )
+    for _ in range(3):  # three bounces on the belt, none on a wall
+        a, b = moving.step(), fixed.step()
+        assert a.kind == b.kind == "wall" and a.time == pytest.approx(b.time, rel=1e-13)
+        assert moving.velocities[0] == pytest.approx(fixed.velocities[0] + [0.5, 0.0], rel=1e-12, abs=1e-12)
+    assert a.time == pytest.approx(math.sqrt(2 * 2.5 / 2.0) * 5, rel=1e-12)  # fall 2.5, then two full hops
+
+
+def test_a_rising_platform_meets_a_falling_ball_and_sends_it_up_at_2u_minus_v():
+    # The ball falls from y = 8 (g = 1); the platform y = 1 + 0.5 t rises: 7.5 - t^2 / 2 = 1.5 + 0.5 t... its rim
+    # at y - 0.5 meets the platform when 8 - t^2 / 2 - 0.5 = 1 + 0.5 t, t = (-0.5 + sqrt(0.25 + 13)) / 1.
+    platform = ds.Segment((2.0, 1.0), (8.0, 1.0), velocity=(0.0, 0.5))
+    sim = ds.EventDriven(ball(5.0, 8.0), BOX, segments=[platform], gravity=(0.0, -1.0))
+    event = sim.step()
+    t = -0.5 + math.sqrt(0.25 + 13.0)
+    assert (event.kind, event.time) == ("wall", pytest.approx(t, rel=1e-13))
+    assert sim.velocities[0] == pytest.approx([0.0, 2 * 0.5 + t], rel=1e-13)
+    assert not sim.resting[0]
+
+
+def test_a_rising_platform_wakes_a_disc_at_rest_and_what_rests_on_it_falls():
+    # Disc 0 rests on a post (an obstacle), disc 1 on disc 0. A platform rising at 1 from y = 2 meets disc 0 with its
+    # end point (4.6, 2 + t) at t = 1.7 (0.4^2 + 0.3^2 = 0.5^2), normal (0.8, 0.6): in the platform's frame the disc
+    # comes at (0, -1) and leaves at (0.96, -0.28); in the box at (0.96, 0.72). Disc 1, its support gone, falls.
+    discs = ds.Discs([[5.0, 3.0], [5.0, 4.0], [5.0, 5.0]], np.zeros((3, 2)), radii=0.5, masses=[math.inf, 1.0, 1.0])
+    platform = ds.Segment((3.0, 2.0), (4.6, 2.0), velocity=(0.0, 1.0))
+    sim = ds.EventDriven(discs, BOX, segments=[platform], gravity=(0.0, -1.0))
+    sim.run(until=0.1)
+    assert sim.resting.tolist() == [False, True, True]
+    event = sim.step()
+    assert (event.kind, event.i, event.time) == ("wall", 1, pytest.approx(1.7, rel=1e-13))
+    assert sim.velocities[1] == pytest.approx([0.96, 0.72], rel=1e-12)
+    assert sim.resting.tolist() == [False, False, False]
+    assert sim.events[-1]["kind"] == int(ds.EventKind.SET) and sim.events[-1]["i"] == 2  # it falls from here
+    sim.run(until=event.time + 0.2)  # (disc 1, rising, knocks it up at once)
+    assert not sim.resting[2] and sim.velocities[2, 1] != 0.0
+
+
+def test_under_drag_a_disc_meets_a_moving_wall_at_the_exact_time():
+    # x(t) = 2 + (3 / gamma) (1 - exp(-gamma t)) (radius 0.5) against the wall 9 - 0.5 t: bisect the gap's root.
+    gamma = 0.4
+    wall = ds.Segment((9.0, 1.0), (9.0, 9.0), velocity=(-0.5, 0.0))
+    sim = ds.EventDriven(ball(2.0, 5.0, 3.0, 0.0), BOX, segments=[wall], drag=gamma)
+    event = sim.step()
+
+    def gap(t):
+        return 9.0 - 0.5 * t - (2.5 + 3.0 / gamma * (1.0 - math.exp(-gamma * t)))
+
+    lo, hi = 0.0, 20.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if gap(mid) > 0 else (lo, mid)
+    assert event.time == pytest.approx(lo, rel=1e-12)
+    v = 3.0 * math.exp(-gamma * lo)
+    assert sim.velocities[0, 0] == pytest.approx(2 * -0.5 - v, rel=1e-12)
+
+
+def test_a_rough_disc_bounces_off_a_moving_segment_as_off_a_fixed_one_from_its_frame():
+    u = np.array([0.0, 0.7])
+    wall = [ds.Segment((6.0, 0.5), (6.0, 9.5), velocity=u)]
+    spin = ds.Discs([[3.0, 5.0]], [[1.0, 0.4]], radii=0.5, spins=[2.0])
+    moving = ds.EventDriven(spin, BOX, segments=wall, roughness=0.6)
+    still = ds.EventDriven(
+        ds.Discs([[3.0, 5.0]], [[1.0, 0.4 - 0.7]], radii=0.5, spins=[2.0]), BOX,
+        segments=[ds.Segment((6.0, 0.5), (6.0, 9.5))], roughness=0.6,
+    )  # fmt: skip
+    a, b = moving.step(), still.step()
+    assert a.time == pytest.approx(b.time, rel=1e-13)
+    assert moving.velocities[0] == pytest.approx(still.velocities[0] + u, rel=1e-12)
+    assert moving.spins[0] == pytest.approx(still.spins[0], rel=1e-12) and moving.spins[0] != 2.0

@@ -225,9 +225,9 @@ def predict(
         elif k != -2 - exclude:  # not the segment just left
             if LAWS and (seg[k, 6] != 0.0 or seg[k, 7] != 0.0):  # a moving segment: where it is now, in its frame
                 ux, uy = seg[k, 6], seg[k, 7]
-                ts = segment_time_of_impact(
+                ts = segment_time_of_impact(  # (drag -gamma v is -gamma (w + u) in its frame: an added force)
                     xi, yi, vxi - ux, vyi - uy, ri, seg[k, 0] + ux * t, seg[k, 1] + uy * t, seg[k, 2] + ux * t,
-                    seg[k, 3] + uy * t, axi, ayi, drag,
+                    seg[k, 3] + uy * t, axi - drag * ux, ayi - drag * uy, drag,
                 )  # fmt: skip
             else:
                 ts = segment_time_of_impact(
@@ -366,6 +366,7 @@ def run_events(
         pops += 1
         kind = qk[i]
         other = qo[i]
+        woke = -1  # a disc at rest this event wakes: what it held up falls again (below)
         # At large N every record below waits for memory, and the next disc is known only when the queue
         # pops it: ask now for the records of this event's partner and its cells, and of the two events
         # most likely next (the heap's second and third), so that the fetches overlap (no effect on results).
@@ -404,7 +405,6 @@ def run_events(
                 xi, yi, vxi, vyi, mi, xj, yj, vxj, vyj, mj, width, height, periodic, e
             )
             moved_j = mj != INF  # obstacles never move, and their counter never changes
-            woke = -1
             if LAWS and rough:  # the tangential impulse at the contact turns both (at right angles to the normal one)
                 turn(i, t + epoch, rot)
                 turn(j, t + epoch, rot)
@@ -496,30 +496,6 @@ def run_events(
                 )  # fmt: skip
                 if ints[I_SIZE] > max_queue:
                     max_queue = ints[I_SIZE]
-            if LAWS and woke >= 0:  # the discs at rest that the woken support held up fall again from here
-                for m in range(supported(woke, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, found)):
-                    d = found[m]
-                    rec[d, T] = t  # at rest: its record holds where it is, now
-                    count[d] += 1
-                    if recording:  # a SET record: it falls from here (trajectories, the viewer and replays know)
-                        ev_t[logged] = t + epoch
-                        ev_kind[logged] = SET
-                        ev_i[logged] = order[d]
-                        ev_j[logged] = -1
-                        ev_f[logged, 0], ev_f[logged, 1] = rec[d, X], rec[d, Y]
-                        ev_f[logged, 2] = ev_f[logged, 3] = 0.0
-                        ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
-                        if rough:
-                            ev_w[logged, 0], ev_w[logged, 1] = rot[d, W], np.nan
-                        logged += 1
-                    predict(
-                        d, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                        nx, ny, periodic, edges,
-                        seg, seg_start, seg_idx, group, blocked, rest,
-                        qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
-                    )  # fmt: skip
-                if ints[I_SIZE] > max_queue:
-                    max_queue = ints[I_SIZE]
             last_time, last_kind, last_i, last_j = t + epoch, COLLISION, i, j
         elif kind == WALL or kind == SEGMENT:
             axi, ayi = accel(i, gravity, gx, gy, rec, rest)
@@ -537,7 +513,10 @@ def run_events(
                     seg[other, 2] + fx * t, seg[other, 3] + fy * t, e,
                 )  # fmt: skip
                 vxi, vyi = vxi + fx, vyi + fy
-                exclude = -2 - other
+                exclude = -1 if gravity else -2 - other
+                if gravity and rest[i] != 0:  # it hit a disc at rest: it flies, and what it held up falls
+                    rest[i] = 0
+                    woke = i
             elif kind == SEGMENT:
                 vxi, vyi = reflect_off_segment(
                     xi, yi, vxi, vyi, seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3], e
@@ -548,9 +527,9 @@ def run_events(
                 vxi, vyi = reflect(vxi, vyi, other, e)
                 exclude = -1
             if LAWS and rough:  # the wall (or segment) is as rough as the discs: the same law against an infinite mass
-                if kind == SEGMENT:
-                    sx0, sy0, sx1, sy1 = seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
-                    qx, qy = closest_point_on_segment(xi, yi, sx0, sy0, sx1, sy1)
+                if kind == SEGMENT:  # (where it is now, in its frame if it moves)
+                    sx0, sy0, sx1, sy1 = seg[other, 0] + fx * t, seg[other, 1] + fy * t, seg[other, 2], seg[other, 3]
+                    qx, qy = closest_point_on_segment(xi, yi, sx0, sy0, sx1 + fx * t, sy1 + fy * t)
                     cxw, cyw = qx - xi, qy - yi  # from the centre towards the contact point
                 elif other == 0:
                     cxw, cyw = (-1.0 if xi < 0.5 * width else 1.0), 0.0
@@ -559,11 +538,12 @@ def run_events(
                 turn(i, t + epoch, rot)
                 wi = rot[i, W]
                 txi, tyi, _, _, rot[i, W], _ = rough_impulse(
-                    cxw, cyw, wx, wy, 0.0, 0.0, wi, 0.0, rec[i, R], 0.0, rec[i, M], INF, rot[i, INERTIA], INF, beta
-                )
-                vxi, vyi = vxi + (txi - wx), vyi + (tyi - wy)
+                    cxw, cyw, wx - fx, wy - fy, 0.0, 0.0, wi, 0.0, rec[i, R], 0.0, rec[i, M], INF, rot[i, INERTIA], INF,
+                    beta,
+                )  # fmt: skip
+                vxi, vyi = vxi + (txi - (wx - fx)), vyi + (tyi - (wy - fy))
                 floats[F_LOST] += spin_energy(rot[i, INERTIA], wi) - spin_energy(rot[i, INERTIA], rot[i, W])
-            if gravity:  # too slow a bounce off a floor (a support with gravity into it): the disc rests
+            if gravity and fx == 0.0 and fy == 0.0:  # too slow a bounce off a fixed floor: the disc rests
                 if kind == SEGMENT:
                     sx0, sy0, sx1, sy1 = seg[other, 0], seg[other, 1], seg[other, 2], seg[other, 3]
                     qx, qy = closest_point_on_segment(xi, yi, sx0, sy0, sx1, sy1)
@@ -662,6 +642,30 @@ def run_events(
                 have_now = True
                 why = CROSSINGS
                 break
+        if LAWS and woke >= 0:  # the discs at rest that the woken support held up fall again from here
+            for m in range(supported(woke, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, found)):
+                d = found[m]
+                rec[d, T] = t  # at rest: its record holds where it is, now
+                count[d] += 1
+                if recording:  # a SET record: it falls from here (trajectories, the viewer and replays know)
+                    ev_t[logged] = t + epoch
+                    ev_kind[logged] = SET
+                    ev_i[logged] = order[d]
+                    ev_j[logged] = -1
+                    ev_f[logged, 0], ev_f[logged, 1] = rec[d, X], rec[d, Y]
+                    ev_f[logged, 2] = ev_f[logged, 3] = 0.0
+                    ev_f[logged, 4] = ev_f[logged, 5] = ev_f[logged, 6] = ev_f[logged, 7] = np.nan
+                    if rough:
+                        ev_w[logged, 0], ev_w[logged, 1] = rot[d, W], np.nan
+                    logged += 1
+                predict(
+                    d, t, -1, -1, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                    nx, ny, periodic, edges,
+                    seg, seg_start, seg_idx, group, blocked, rest,
+                    qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
+                )  # fmt: skip
+            if ints[I_SIZE] > max_queue:
+                max_queue = ints[I_SIZE]
         now = t
         have_now = True
         if done >= rebase_at:

@@ -210,3 +210,15 @@ def energy_of(discs, mass, pressure, width, height, velocity):
     """The energy above the floor's potential: the discs' kinetic energy, the piston's, and F H."""
     kinetic = 0.5 * float(np.sum(discs.masses * np.sum(discs.velocities**2, axis=1)))
     return kinetic + 0.5 * mass * velocity**2 + pressure * width * height
+
+
+def test_thermo_of_a_piston_run_reads_a_streamed_log_as_the_one_in_memory(tmp_path):
+    discs, _ = ds.random_gas(20, 0.3, seed=8, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 1.5, 100.0)
+    piston = ds.Piston(mass=5.0, pressure=0.3, height=float((discs.positions[:, 1] + discs.radii).max()) + 0.5)
+    kept = ds.EventDriven(discs, box, piston=piston).run(until=30.0)
+    streamed = ds.EventDriven(discs, box, piston=piston, record=False).run(until=30.0, record_to=tmp_path / "run")
+    a, b = ds.thermo(kept, since=3.0), ds.thermo(streamed, since=3.0)
+    assert (a.area, a.energy, a.z, a.hits) == (b.area, b.energy, b.z, b.hits)
+    with pytest.raises(InvalidArgumentError, match="record"):
+        ds.thermo(ds.EventDriven(discs, box, piston=piston, record=False).run(until=5.0))

@@ -222,3 +222,22 @@ def test_thermo_of_a_piston_run_reads_a_streamed_log_as_the_one_in_memory(tmp_pa
     assert (a.area, a.energy, a.z, a.hits) == (b.area, b.energy, b.z, b.hits)
     with pytest.raises(InvalidArgumentError, match="record"):
         ds.thermo(ds.EventDriven(discs, box, piston=piston, record=False).run(until=5.0))
+
+
+def test_a_heavy_piston_over_one_disc_oscillates_at_the_adiabatic_frequency():
+    # One disc (m = 1) bouncing at v between the floor and a piston M = 100 under F = 1: it pushes with m v^2 / L on
+    # average (L = H - 2r, the centre's run), so the piston sits where m v^2 = F L, here L = 4 at v = 2. Slow
+    # against the bounces, the disc is a 1D gas (gamma = 3: v L constant), F L^3 constant under slow moves, so the
+    # piston oscillates at omega^2 = 3 F / (M L): a period of 2 pi sqrt(M L / 3 F) = 72.55.
+    r, length, force, mass = 0.5, 4.0, 1.0, 100.0
+    piston = ds.Piston(mass=mass, pressure=force / 10.0, height=length + 2 * r, velocity=0.02)
+    sim = ds.EventDriven(ball(5.0, r, 0.0, 2.0, r=r), ds.Box(10.0, 20.0), piston=piston)
+    times = np.arange(0.0, 800.0, 0.25)
+    heights = []
+    for t in times:
+        sim.run(until=t)
+        heights.append(sim.piston.height)
+    h = np.asarray(heights) - np.mean(heights)
+    ups = times[1:][(h[:-1] < 0) & (h[1:] >= 0)]  # the piston's upward passes through its mean height
+    period = float(np.median(np.diff(ups)))
+    assert period == pytest.approx(2 * math.pi * math.sqrt(mass * length / (3 * force)), rel=0.02)

@@ -104,6 +104,13 @@ def isobaric(sim, since: float | str | None = None) -> IsobaricAverages:
     if piston is None:
         msg = "isobaric() needs a run with a piston (EventDriven(..., piston=ds.Piston(...)))"
         raise InvalidArgumentError(msg)
+    laws = getattr(sim, "laws", None)
+    if laws is not None and laws.falls:
+        msg = (
+            f"isobaric() averages a gas that keeps its kinetic energy between the piston's impacts; under gravity "
+            f"{laws.gravity} it does not (sample it with ds.Sampler(dt) and sim.piston instead)"
+        )
+        raise InvalidArgumentError(msg)
     from discsim.analysis.frames import _log_source
 
     chunks = _log_source(sim, "isobaric()")[0]  # (refuses a run that recorded nothing, saying how to record)

@@ -7,7 +7,9 @@ the matplotlib object it made or drew on; with ``ax=None`` it makes a new figure
 
 Lengths are drawn to scale: discs are circles of their true radii and the
 axes have equal aspect.
-An engine's sensors (``sim.sensors``) are drawn under the discs, as the viewer draws them.
+An engine's sensors (``sim.sensors``) are drawn under the discs, as the viewer draws them. Its segments
+(``sim.segments``) are drawn where they are at the time drawn: a moving one (``Segment(..., velocity=v)``) from
+``p0 + v t`` to ``p1 + v t``, at each frame of an animation.
 """
 
 from __future__ import annotations
@@ -67,6 +69,20 @@ def _setup(ax, box, sensors=()) -> None:
     pad = 0.02 * max(box.width, box.height)
     ax.set_xlim(-pad, box.width + pad)
     ax.set_ylim(-pad, box.height + pad)
+
+
+def _segment_lines(segments, time: float) -> list[np.ndarray]:
+    """Each segment's end points ``(2, 2)`` at ``time``: a moving one where :meth:`Segment.at` puts it."""
+    return [np.array([moved.p0, moved.p1]) for moved in (s.at(time) for s in segments)]
+
+
+def _draw_segments(ax, segments, time: float):
+    """The segments (``sim.segments``) at ``time`` as one ``LineCollection`` (gid ``"segments"``), None: none."""
+    if not len(segments):
+        return None
+    lines = LineCollection(_segment_lines(segments, time), colors="0.2", linewidths=2.0, zorder=2.5, gid="segments")
+    ax.add_collection(lines)
+    return lines
 
 
 def _circles(ax, positions, radii, colours, *, alpha=0.6, fill=True, linestyle="-", linewidth=1.0, zorder=2):
@@ -136,6 +152,8 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True, marks: b
         quiver = _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
         if quiver is not None and box is not None:  # arrows end at the walls, as the discs do
             quiver.set_clip_path(Rectangle((0.0, 0.0), box.width, box.height, transform=ax.transData))
+    if time is not None:
+        _draw_segments(ax, getattr(sim_or_discs, "segments", ()), time)
     _setup(ax, box, getattr(sim_or_discs, "sensors", ()))
     if box is None and len(positions):
         r = float(discs.radii.max())
@@ -205,6 +223,7 @@ def plot_trajectories(sim, ax=None, discs=None, *, samples: int = 400):
     starts = paths[0, chosen]
     ax.scatter(starts[:, 0], starts[:, 1], s=8, c=[colours[i] for i in chosen.tolist()], zorder=3)
     _circles(ax, paths[-1, chosen], sim.discs.radii[chosen], [colours[i] for i in chosen.tolist()], fill=False)
+    _draw_segments(ax, getattr(sim, "segments", ()), float(times[-1]))  # where they are with the final outlines
     _setup(ax, sim.box, getattr(sim, "sensors", ()))
     ax.set_title(f"{type(sim).__name__}: paths over t in [{times[0]:.3g}, {times[-1]:.3g}]")
     return ax
@@ -310,6 +329,7 @@ def _draw_case_panel(ax, sim, truth, frames, times, arrow_time, contact_style, t
         vel = np.concatenate([np.column_stack([own["vxi"], own["vyi"]]), np.column_stack([own["vxj"], own["vyj"]])])
         who = np.concatenate([own["i"], own["j"]]).tolist()
         _arrows(ax, pos, vel, arrow_time, [colours[d] for d in who])
+    _draw_segments(ax, getattr(sim, "segments", ()), float(times[-1]))  # where they are at the last frame
     _setup(ax, sim.box, getattr(sim, "sensors", ()))
     ax.set_xlim(limits[0], limits[1])
     ax.set_ylim(limits[2], limits[3])
@@ -507,7 +527,8 @@ def animate(
     """Animate one run, or several side by side, from their event logs.
 
     The time is written above the first panel, clear of the discs (with the frame number on a PIT frame
-    time), and the collisions of the event-driven runs are outlined from their time on (solid on their own
+    time), each run's segments are drawn where they are at each frame's time (a moving one from ``p0 + v t`` to
+    ``p1 + v t``), and the collisions of the event-driven runs are outlined from their time on (solid on their own
     panel, dashed on the others, as in :func:`plot_case`).
 
     Args:
@@ -596,11 +617,16 @@ def animate(
         if len(sims) > 1:
             for truth in truths:
                 outlines += _contact_outlines(ax, truth, colours, "-" if truth is s else "--")
+        segments = tuple(getattr(s, "segments", ()))
+        walls = _draw_segments(ax, segments, float(times[0]))
+        moving = walls if any(segment.moving for segment in segments) else None  # moved at each frame
+        if moving is not None:
+            dynamic.append(moving)
         _setup(ax, s.box, getattr(s, "sensors", ()))
         ax.set_xlim(limits[0], limits[1])
         ax.set_ylim(limits[2], limits[3])
         ax.set_title(type(s).__name__, fontsize=10, loc="left")
-        panels.append((paths, discs, quiver, speeds if arrows else None))
+        panels.append((paths, discs, quiver, speeds if arrows else None, segments, moving))
     dynamic += [patch for _, patch in outlines]
     clock = axes[0][0].text(
         1.0, 1.02, "", transform=axes[0][0].transAxes, ha="right", va="bottom", fontsize=9, zorder=6
@@ -611,13 +637,15 @@ def animate(
     fig.tight_layout()
 
     def update(k):
-        for paths, discs, quiver, speeds in panels:
+        for paths, discs, quiver, speeds, segments, moving in panels:
             here = paths[k]
             gone = ~np.isfinite(here).all(axis=1)  # not there at this time (added later, or removed)
             discs.set_offsets(np.where(gone[:, None], 1e9, here))
             if quiver is not None:
                 quiver.set_offsets(np.where(gone[:, None], 1e9, here))
                 quiver.set_UVC(*np.nan_to_num(speeds[k]).T)
+            if moving is not None:
+                moving.set_segments(_segment_lines(segments, float(times[k])))
         for t, patch in outlines:
             patch.set_visible(t <= times[k])
         frame = (times[k] - times[0]) / dt if dt > 0 else math.nan

@@ -261,8 +261,6 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
         backend, sensors = _choose_backend(backend, policy), check_sensors(sensors)
         scene = _moving_segments(Scene(discs, box, segments, pass_through, sensors=sensors), laws, policy)
-        if scene.moving:  # the compiled frame does not move segments yet: the Python frame runs them
-            backend = "python"
         laws = laws.checked(scene)
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws, sensors)
         self._load(self._initial_state())

@@ -79,14 +79,13 @@ DEFAULT_BISECT_FRACTION = 1e-6
 
 
 #: The policies that answer a moving segment (at the frame, in the segment's frame).
-MOVING_SEGMENT_POLICIES = ("resolve", "separate")
+MOVING_SEGMENT_POLICIES = ("resolve", "revert", "separate")
 
 
 def _moving_segments(scene: Scene, laws: Laws, policy: str) -> Scene:
     """``scene``, unless a segment moves where this engine cannot move it: under gravity, drag or roughness (as
-    ``EventDriven`` refuses them), or with a policy other than :data:`MOVING_SEGMENT_POLICIES` (``"revert"`` puts
-    the disc back where it was at the previous frame, where the segment no longer is; ``"bisect"`` and ``"swept"``
-    test fixed segments inside a frame).
+    ``EventDriven`` refuses them), or with a policy other than :data:`MOVING_SEGMENT_POLICIES` (``"bisect"`` and
+    ``"swept"`` test fixed segments inside a frame).
 
     Raises:
         InvalidArgumentError: naming the first moving segment and the law or the policy.
@@ -131,8 +130,9 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
             only), tested against every disc at each frame (few segments). A moving segment is tested where it is
             at the frame's time (``p0 + velocity * t``) and bounces a disc in its own frame (the velocity relative to
             it reflected, the restitution applied, its velocity added back; what the bounce takes, in its frame, in
-            :attr:`dissipated`): policies ``"resolve"`` and ``"separate"`` only, under the default laws or
-            restitution (as ``EventDriven``).
+            :attr:`dissipated`; ``"revert"`` puts the disc back where it was at the previous frame and tests it
+            against the segment where it is at the frame): the policies that answer at the frame only, under the
+            default laws or restitution (as ``EventDriven``).
         pass_through: pairs of group labels (``discs.groups``) whose discs do
             not collide with each other, as for
             :class:`~discsim.engines.event_driven.EventDriven`. Free when empty.
@@ -168,8 +168,8 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
             not a positive finite number, a law refused as ``EventDriven`` refuses it (a negative or non-finite
             ``drag`` too), gravity or drag with a sub-frame policy, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
-            a periodic box, a moving segment under gravity, drag or roughness or with a policy other than
-            ``"resolve"`` or ``"separate"`` (naming the segment), ``backend="numba"`` without numba (naming the extra to
+            a periodic box, a moving segment under gravity, drag or roughness or with ``"bisect"`` or
+            ``"swept"`` (naming the segment), ``backend="numba"`` without numba (naming the extra to
             install), ``sensors`` not a list of :class:`~discsim.sensors.Sensor` (naming the item).
         TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
         InvalidDiscsError: on a malformed ``pass_through``.

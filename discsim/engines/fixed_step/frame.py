@@ -37,7 +37,6 @@ from discsim.engines.fixed_step.parts import (
     push_off_segment,
     restitution,
     rough_pair,
-    segment_bounce,
     separate_pair,
     spin_loss,
     wall_bounce,
@@ -398,28 +397,33 @@ class Revert(FramePolicy):
         return pos
 
     def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0), speeds=None):
+        # A moving segment stays where it is at the frame; the disc goes back, and is tested and bounced in the
+        # segment's frame.
         reverted = False
         responded = False
         w, m, inertia, beta = turn
-        for ends in hits:
+        for k, ends in enumerate(hits):
+            sx, sy = (0.0, 0.0) if speeds is None else speeds[k]
             qx, qy = closest_point_on_segment(x, y, *ends)
             nx, ny = x - qx, y - qy
             if not reverted:
                 px, py = previous.tolist()
                 bx, by = closest_point_on_segment(px, py, *ends)
-                if vx * (px - bx) + vy * (py - by) < 0.0:  # approaching there: reflect at the restored place
+                if (vx - sx) * (px - bx) + (vy - sy) * (
+                    py - by
+                ) < 0.0:  # approaching there: reflect at the restored place
                     x, y, nx, ny = px, py, px - bx, py - by
                     reverted = True
-                elif vx * nx + vy * ny < 0.0:  # approaching only at the frame: restore, keep the frame's normal
+                elif (vx - sx) * nx + (vy - sy) * ny < 0.0:  # approaching only at the frame: restore, keep its normal
                     fx, fy = x, y
                     x, y = px, py
                     reverted = True
-                    vx, vy, w = segment_bounce(fx, fy, vx, vy, *ends, e, w, r, m, inertia, beta)
+                    vx, vy, w = moving_segment_bounce(fx, fy, vx, vy, *ends, sx, sy, e, w, r, m, inertia, beta)
                     responded = True
                     continue
-            if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
+            if (vx - sx) * nx + (vy - sy) * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
-            vx, vy, w = segment_bounce(x, y, vx, vy, *ends, e, w, r, m, inertia, beta)
+            vx, vy, w = moving_segment_bounce(x, y, vx, vy, *ends, sx, sy, e, w, r, m, inertia, beta)
             responded = True
         return x, y, vx, vy, w, responded
 

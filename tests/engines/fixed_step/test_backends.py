@@ -197,7 +197,7 @@ def test_both_backends_give_the_same_frames_under_roughness(scene, policy):
 
 
 @needs_numba
-@pytest.mark.parametrize("policy", ["resolve", "separate"])
+@pytest.mark.parametrize("policy", FRAME_POLICIES)
 def test_both_backends_give_the_same_frames_with_moving_segments(policy):
     """Two paddles sweeping a walled gas (with a fixed segment and restitution): the segments where they are at
     each frame, the bounces in their frames, the energy they take: the same log, state and losses, bit for bit."""

@@ -203,7 +203,7 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e, w, m, inert
     ``FramePolicy.off_segments`` (``"resolve"``, ``"separate"``) and ``Revert.off_segments``; ``(px, py)``
     is the disc's position at the previous frame; ``w``, ``m``, ``inertia``: its spin, mass, moment of inertia;
     ``beta``: the roughness. ``segments`` ``(S, 6)``: the ends where they are at the frame and the velocities (a
-    moving segment is approached, and bounces the disc, in its frame; only ``"resolve"`` and ``"separate"`` get one).
+    moving segment is approached, and bounces the disc, in its frame; ``"revert"`` tests it where it is at the frame).
     """
     responded = False
     reverted = False
@@ -214,14 +214,14 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e, w, m, inert
         nx, ny = x - qx, y - qy
         if policy == REVERT and not reverted:
             cx, cy = _closest_point(px, py, ax, ay, bx, by)
-            if vx * (px - cx) + vy * (py - cy) < 0.0:  # approaching there: reflect at the restored place
+            if (vx - sx) * (px - cx) + (vy - sy) * (py - cy) < 0.0:  # approaching there: reflect at the restored place
                 x, y, nx, ny = px, py, px - cx, py - cy
                 reverted = True
-            elif vx * nx + vy * ny < 0.0:  # approaching only at the frame: restore, keep the frame's normal
+            elif (vx - sx) * nx + (vy - sy) * ny < 0.0:  # approaching only at the frame: restore, keep its normal
                 fx, fy = x, y
                 x, y = px, py
                 reverted = True
-                vx, vy, w = _segment_bounce(fx, fy, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, beta)
+                vx, vy, w = _moving_segment_bounce(fx, fy, vx, vy, ax, ay, bx, by, sx, sy, e, w, r, m, inertia, beta)
                 responded = True
                 continue
         if (vx - sx) * nx + (vy - sy) * ny >= 0.0:  # receding (or the centre is on the segment): leave it

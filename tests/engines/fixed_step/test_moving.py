@@ -9,6 +9,7 @@ import pytest
 
 import discsim as ds
 from discsim.errors import InvalidArgumentError
+from discsim.events import WALL
 
 BOX = ds.Box(10.0, 10.0)
 MOVING_POLICIES = ("resolve", "revert", "separate")
@@ -102,3 +103,30 @@ def test_energy_and_momentum_bookkeeping_of_a_paddle_bounce_at_e_below_one():
     assert sim.counts["wall_hits"] == 1
     assert np.allclose(sim.velocities, [[-2.0 - 0.5 * 3.0, 0.0]], rtol=0, atol=1e-14)
     assert sim.dissipated == pytest.approx(0.5 * sim.discs.masses[0] * 9.0 * (1 - 0.25), rel=1e-14)
+
+
+def test_the_paddle_tunnel_case_pic_bounces_at_the_closed_form_time_and_pit_tunnels_at_its_default_rate():
+    case = ds.scenarios.paddle_tunnel()
+    assert case.name in [c.name for c in ds.scenarios.law_cases()]
+    (paddle,) = case.laws["segments"]
+    (x_d, _), (v_d, _), r = case.discs.positions[0], case.discs.velocities[0], case.discs.radii[0]
+    x_p, v_p = paddle.p0[0], paddle.velocity[0]
+    t_c = (x_p - x_d - r) / (v_d - v_p)  # the docstring's closed form: 0.41
+    assert t_c == pytest.approx(0.41, rel=1e-14)
+    pic = ds.EventDriven(case.discs, case.box, **case.laws).run(until=case.until)
+    assert pic.events["kind"].tolist() == [WALL]
+    assert pic.events["time"][0] == pytest.approx(t_c, rel=1e-14)
+    assert pic.events["vxi"][0] == pytest.approx(-(v_d - 2 * v_p), rel=1e-14)  # -(speed + 2 paddle_speed) = -40
+    assert pic.positions[0, 0] < paddle.at(case.until).p0[0]  # back on its own side
+    for policy in MOVING_POLICIES:  # the default rate: the frames straddle the crossing, the disc flies through
+        pit = ds.FixedStep(case.discs, case.box, frame_rate=case.frame_rate, policy=policy, **case.laws)
+        pit.run(until=case.until)
+        assert pit.counts["wall_hits"] == 0
+        assert pit.positions[0, 0] == pytest.approx(x_d + v_d * case.until) and pit.positions[0, 0] > x_p + v_p * 0.6
+        report = ds.compare(pic, pit)
+        assert (report.truth_wall_hits, report.approx_wall_hits) == (1, 0)
+    # Fast enough frames catch it, late by less than a frame, with the exact bounce.
+    pit = ds.FixedStep(case.discs, case.box, frame_rate=150.0, policy="resolve", **case.laws).run(until=case.until)
+    assert pit.counts["wall_hits"] == 1
+    assert t_c < pit.events["time"][0] < t_c + 1.0 / 150.0
+    assert pit.velocities.tolist() == [[-40.0, 0.0]]

@@ -130,3 +130,17 @@ def test_the_paddle_tunnel_case_pic_bounces_at_the_closed_form_time_and_pit_tunn
     assert pit.counts["wall_hits"] == 1
     assert t_c < pit.events["time"][0] < t_c + 1.0 / 150.0
     assert pit.velocities.tolist() == [[-40.0, 0.0]]
+
+
+def test_a_run_with_a_paddle_continues_from_a_checkpoint_bit_for_bit(tmp_path):
+    # The checkpoint keeps the segment's ends at time 0 and its velocity: the copy finds it where the run would.
+    discs = ds.Discs([[2.0, 5.0], [4.0, 2.0], [3.0, 8.0]], [[1.0, 0.3], [0.5, 1.0], [2.0, -0.5]], radii=0.5)
+    options = {"dt": 0.1, "segments": [ds.Segment((8.0, 1.0), (8.5, 9.0), velocity=(-0.4, 0.0))], "restitution": 0.9}
+    whole = ds.FixedStep(discs, BOX, **options).run(frames=100)
+    half = ds.FixedStep(discs, BOX, **options).run(frames=50)
+    copy = ds.load(half.save(tmp_path / "half.dsc"))
+    assert copy.scene.segments[0].velocity.tolist() == [-0.4, 0.0]
+    copy.run(frames=50)
+    assert whole.counts["wall_hits"] > 3
+    assert copy.events.tobytes() == whole.events.tobytes()
+    assert copy.positions.tobytes() == whole.positions.tobytes() and copy.dissipated == whole.dissipated

@@ -438,7 +438,8 @@ class Segment:
     Segments build polygonal tables (a triangle, a stadium's straight sides)
     inside a walled box. Discs bounce off the face and off the end points. A segment given a ``velocity`` is
     kinematic (a paddle, a pusher, a conveyor's edge): it moves at that velocity for ever, whatever hits it,
-    and a disc bounces off it in its own frame (``EventDriven`` only; under gravity with elastic bounces only).
+    and a disc bounces off it in its own frame (``EventDriven``, under gravity with elastic bounces only; ``FixedStep``
+    at its frames, under the default laws or restitution).
 
     Args:
         p0, p1: end points ``(2,)`` in length units at time 0; finite and distinct.

@@ -2,7 +2,8 @@
 
 :func:`random_gas` makes seeded, non-overlapping gases at a chosen packing
 fraction. The study's four PIT failure cases, the cases under the laws of motion of issue 27
-(:func:`law_cases`: a ball bouncing to rest) and other set pieces live here too.
+(:func:`law_cases`: a ball bouncing to rest, and a paddle a fast disc tunnels through) and other set pieces live
+here too.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from discsim.errors import InvalidArgumentError, PackingError
-from discsim.model import Box, Discs
+from discsim.model import Box, Discs, Segment
 
 __all__ = [
     "Scenario",
@@ -25,6 +26,7 @@ __all__ = [
     "missed_collision",
     "multiple_collisions",
     "newtons_cradle",
+    "paddle_tunnel",
     "random_gas",
     "study_cases",
     "terminal_fall",
@@ -321,8 +323,9 @@ class Scenario:
         until: the horizon (time units); a whole number of frames.
         name: a short identifier, e.g. ``"missed_collision"``.
         description: one or two sentences on what happens and what PIT gets wrong.
-        laws: the keywords of the laws of motion both engines take (``gravity=``, ``restitution=``; pass
-            them as ``**case.laws``); empty: free flight and elastic collisions.
+        laws: the keywords of the laws of motion both engines take (``gravity=``, ``restitution=``, and
+            ``segments=`` for a case with moving segments; pass them as ``**case.laws``); empty: free flight and
+            elastic collisions off the box's walls.
 
     Example:
         >>> case = missed_collision()
@@ -534,14 +537,52 @@ def terminal_fall(drag: float = 2.0, height: float = 8.0, gravity: float = 9.81,
     )
 
 
+def paddle_tunnel(speed: float = 20.0, paddle_speed: float = 10.0) -> Scenario:
+    """A fast disc and a thin paddle (a moving segment) head for each other; PIT's frames straddle the crossing
+    (issue 28).
+
+    One disc of radius ``r = 0.2`` at ``x_d = 2`` on the line y = 5 of a 20 x 10 box, moving at ``speed`` along
+    x; a vertical paddle (the segment x = ``x_p = 14.5``, y from 3 to 7, ``laws["segments"]``) moving at
+    ``-paddle_speed``. Exactly (PIC) the disc's edge meets the paddle at
+    ``t_c = (x_p - x_d - r) / (speed + paddle_speed)`` (0.41 at the defaults), and the bounce in the paddle's
+    frame sends the disc back at ``-(speed + 2 paddle_speed)`` (-40). PIT (30 frames per unit time) moves the two
+    1 closer per frame (30 / 30), more than the disc's diameter: at the defaults the frame at 0.4 finds the centre
+    0.5 short of the paddle and the one at 0.4333 0.5 past it, so the disc tunnels through and flies on (to x = 14
+    at ``until``). A frame must find the centre less than ``r`` short of the paddle (a centre past a thin paddle
+    moves away from it): with ``"resolve"`` at 150 frames per unit time (0.2 a frame) the frame at 0.41333 does,
+    0.0033 late; ``"revert"``, which tests the disc where it was at the frame before, catches it from 60.
+
+    Example:
+        >>> case = paddle_tunnel()
+        >>> case.laws["segments"], case.frame_rate, case.until
+        ((Segment([14.5, 3.0], [14.5, 7.0], velocity=[-10.0, 0.0]),), 30.0, 0.6)
+    """
+    r = 0.2
+    discs = Discs([[2.0, 5.0]], [[float(speed), 0.0]], radii=r)
+    paddle = Segment((14.5, 3.0), (14.5, 7.0), velocity=(-float(paddle_speed), 0.0))
+    return Scenario(
+        discs,
+        Box(20.0, 10.0),
+        frame_rate=30.0,
+        until=0.6,
+        name="paddle_tunnel",
+        description=(
+            "A fast disc and a thin moving paddle close 1 per frame, more than the disc's diameter: PIT's frames "
+            "straddle the crossing and the disc tunnels through the paddle, which PIC bounces it off at the exact "
+            "time."
+        ),
+        laws={"segments": (paddle,)},
+    )
+
+
 def law_cases() -> list[Scenario]:
-    """The cases that compare PIT against PIC under the laws of issue 27 (run both with ``**case.laws``).
+    """The cases that compare PIT against PIC under the laws of issues 27 and 28 (run both with ``**case.laws``).
 
     Example:
         >>> [case.name for case in law_cases()]
-        ['bouncing_ball', 'terminal_fall']
+        ['bouncing_ball', 'terminal_fall', 'paddle_tunnel']
     """
-    return [bouncing_ball(), terminal_fall()]
+    return [bouncing_ball(), terminal_fall(), paddle_tunnel()]
 
 
 def head_on(m1: float = 1.0, m2: float = 1.0) -> Scenario:

@@ -31,8 +31,10 @@ class Shapes:
         diameter: the largest diameter (a third of the box's shorter side with no discs): the broad phase's
             cell side.
         max_radius: half of ``diameter``.
-        seg_a, seg_b ``(S, 2)``: the segments' end points; seg_ends (list of S tuples
-            ``(x0, y0, x1, y1)``): the same as floats.
+        seg_a, seg_b ``(S, 2)``: the segments' end points at time 0; seg_ends (list of S tuples
+            ``(x0, y0, x1, y1)``): the same as floats. seg_v ``(S, 2)``: the segments' velocities (length / time);
+            seg_speeds (list of S tuples ``(vx, vy)``): the same as floats; seg_moving (bool): some segment moves
+            (:meth:`segments_at` gives the ends at a frame's time).
         group (list of N ints) and blocked (G lists of G bools): the collision filter
             (:meth:`~discsim.scene.Scene.passes`) as lists, or None when no groups pass through each other.
         laws: the run's :class:`~discsim.laws.Laws`. gravity: ``(gx, gy)``. drag: the drag ``gamma`` (0: none).
@@ -60,6 +62,9 @@ class Shapes:
         self.seg_a = np.array([segment.p0 for segment in scene.segments]).reshape(-1, 2)
         self.seg_b = np.array([segment.p1 for segment in scene.segments]).reshape(-1, 2)
         self.seg_ends = [(*segment.p0.tolist(), *segment.p1.tolist()) for segment in scene.segments]
+        self.seg_v = np.array([segment.velocity for segment in scene.segments]).reshape(-1, 2)
+        self.seg_speeds = [tuple(segment.velocity.tolist()) for segment in scene.segments]
+        self.seg_moving = bool(self.seg_v.any())
         self.group = scene.group.tolist() if scene.filtering else None
         self.blocked = scene.blocked.tolist() if scene.filtering else None
         laws = Laws.build() if laws is None else laws
@@ -75,6 +80,14 @@ class Shapes:
         self.beta, self.rough = laws.roughness, laws.rough
         self.inertia = np.array(discs.inertia)
         self.inertias = discs.inertia.tolist()
+
+    def segments_at(self, t: float) -> tuple[np.ndarray, np.ndarray, list]:
+        """``(seg_a, seg_b, seg_ends)`` where the segments are at time ``t``: ``p0 + velocity * t`` (the attributes
+        themselves when no segment moves; the compiled frame computes the same floats)."""
+        if not self.seg_moving:
+            return self.seg_a, self.seg_b, self.seg_ends
+        a, b = self.seg_a + self.seg_v * t, self.seg_b + self.seg_v * t
+        return a, b, [tuple(row) for row in np.concatenate([a, b], axis=1).tolist()]
 
 
 class Paths:

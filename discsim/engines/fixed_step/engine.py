@@ -78,11 +78,32 @@ DEFAULT_FRAME_RATE = 30.0
 DEFAULT_BISECT_FRACTION = 1e-6
 
 
-def _fixed_segments(scene: Scene) -> Scene:
-    """``scene``, unless a segment moves (refused by name: FixedStep moves no segment yet)."""
-    if scene.moving:
-        k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
-        msg = f"segments[{k}] {scene.segments[k]!r} moves: FixedStep moves no segment yet (EventDriven does)"
+#: The policies that answer a moving segment (at the frame, in the segment's frame).
+MOVING_SEGMENT_POLICIES = ("resolve", "revert", "separate")
+
+
+def _moving_segments(scene: Scene, laws: Laws, policy: str) -> Scene:
+    """``scene``, unless a segment moves where this engine cannot move it: under gravity, drag or roughness (as
+    ``EventDriven`` refuses them), or with a policy other than :data:`MOVING_SEGMENT_POLICIES` (``"bisect"`` and
+    ``"swept"`` test fixed segments inside a frame).
+
+    Raises:
+        InvalidArgumentError: naming the first moving segment and the law or the policy.
+    """
+    if not scene.moving:
+        return scene
+    k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
+    if laws.falls or laws.drag != 0.0 or laws.rough:
+        msg = (
+            f"segments[{k}] {scene.segments[k]!r} moves: moving segments run under the default laws or "
+            f"restitution only, not yet with gravity={laws.gravity}, drag={laws.drag}, roughness={laws.roughness}"
+        )
+        raise InvalidArgumentError(msg)
+    if policy not in MOVING_SEGMENT_POLICIES:
+        msg = (
+            f"segments[{k}] {scene.segments[k]!r} moves: policy {policy!r} cannot answer a moving segment; "
+            f"use one of {list(MOVING_SEGMENT_POLICIES)} (or EventDriven)"
+        )
         raise InvalidArgumentError(msg)
     return scene
 
@@ -105,8 +126,13 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
             half the skin: O(N) per frame) or ``"all-pairs"`` (every pair tested,
             O(N^2) per frame). Both give identical results.
         record: keep the event log (needed by ``events`` and ``trajectory``).
-        segments: fixed :class:`~discsim.model.Segment` walls (walled boxes
-            only), tested against every disc at each frame (few segments).
+        segments: :class:`~discsim.model.Segment` walls (walled boxes
+            only), tested against every disc at each frame (few segments). A moving segment is tested where it is
+            at the frame's time (``p0 + velocity * t``) and bounces a disc in its own frame (the velocity relative to
+            it reflected, the restitution applied, its velocity added back; what the bounce takes, in its frame, in
+            :attr:`dissipated`; ``"revert"`` puts the disc back where it was at the previous frame and tests it
+            against the segment where it is at the frame): the policies that answer at the frame only, under the
+            default laws or restitution (as ``EventDriven``).
         pass_through: pairs of group labels (``discs.groups``) whose discs do
             not collide with each other, as for
             :class:`~discsim.engines.event_driven.EventDriven`. Free when empty.
@@ -142,7 +168,8 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
             not a positive finite number, a law refused as ``EventDriven`` refuses it (a negative or non-finite
             ``drag`` too), gravity or drag with a sub-frame policy, both of ``frame_rate`` and ``dt`` given
             and disagreeing, an unknown policy, broad phase or backend, segments in
-            a periodic box, ``backend="numba"`` without numba (naming the extra to
+            a periodic box, a moving segment under gravity, drag or roughness or with ``"bisect"`` or
+            ``"swept"`` (naming the segment), ``backend="numba"`` without numba (naming the extra to
             install), ``sensors`` not a list of :class:`~discsim.sensors.Sensor` (naming the item).
         TypeError: if ``discs``, ``box`` or a segment is of the wrong type.
         InvalidDiscsError: on a malformed ``pass_through``.
@@ -233,7 +260,7 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
         backend, sensors = _choose_backend(backend, policy), check_sensors(sensors)
-        scene = _fixed_segments(Scene(discs, box, segments, pass_through, sensors=sensors))
+        scene = _moving_segments(Scene(discs, box, segments, pass_through, sensors=sensors), laws, policy)
         laws = laws.checked(scene)
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws, sensors)
         self._load(self._initial_state())

@@ -33,10 +33,10 @@ from discsim.engines.fixed_step.broad_phase import BroadPhase
 from discsim.engines.fixed_step.parts import (
     impulse_virial,
     kinetic_loss,
+    moving_segment_bounce,
     push_off_segment,
     restitution,
     rough_pair,
-    segment_bounce,
     separate_pair,
     spin_loss,
     wall_bounce,
@@ -74,10 +74,14 @@ def walls_crossed(pos: np.ndarray, vel: np.ndarray, radii: np.ndarray, size: np.
     return (pos < r) & (vel < 0.0), (pos > size - r) & (vel > 0.0)
 
 
-def segments_cut(pos: np.ndarray, shapes: Shapes, counts: dict[str, int]):
-    """``(discs, segments)``: int arrays of the pairs where a segment cuts a disc at ``pos``; counts the tests."""
+def segments_cut(pos: np.ndarray, shapes: Shapes, counts: dict[str, int], ends=None):
+    """``(discs, segments)``: int arrays of the pairs where a segment cuts a disc at ``pos``; counts the tests.
+
+    ``ends``: ``(seg_a, seg_b)``, where the segments are (:meth:`Shapes.segments_at`; None: at time 0).
+    """
     counts["segment_tests"] += len(pos) * len(shapes.seg_ends)
-    dist = point_segment_distance(pos[:, None, :], shapes.seg_a[None], shapes.seg_b[None])
+    seg_a, seg_b = (shapes.seg_a, shapes.seg_b) if ends is None else ends
+    dist = point_segment_distance(pos[:, None, :], seg_a[None], seg_b[None])
     return np.nonzero(dist < shapes.radii[:, None])
 
 
@@ -140,25 +144,28 @@ class FramePolicy(Policy):
         """Where discs ``rows`` found past a wall (``low``, ``high``: see :func:`walls_crossed`) are left."""
         return pos
 
-    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0)):
+    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0), speeds=None):
         """Answer one disc at ``(x, y)`` moving at ``(vx, vy)`` that cuts segments ``hits`` (end point tuples).
 
         The segments are visited in order, each seeing the position and velocity the one before left
         (a disc in a corner may touch two). ``previous``: the disc's ``(2,)`` position at the previous frame;
-        ``e``: the restitution of its bounces; ``turn``: ``(spin, mass, inertia, roughness)`` (smooth: -1).
+        ``e``: the restitution of its bounces; ``turn``: ``(spin, mass, inertia, roughness)`` (smooth: -1);
+        ``speeds``: each segment's velocity ``(fx, fy)`` (None: all fixed): a moving segment is approached,
+        and bounces the disc, in its own frame (:func:`~discsim.engines.fixed_step.parts.moving_segment_bounce`).
 
         Returns:
             ``(x, y, vx, vy, spin, responded)``.
         """
         responded = False
         w, m, inertia, beta = turn
-        for ends in hits:
+        for k, ends in enumerate(hits):
+            fx, fy = (0.0, 0.0) if speeds is None else speeds[k]
             qx, qy = closest_point_on_segment(x, y, *ends)
             nx, ny = x - qx, y - qy
-            if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
+            if (vx - fx) * nx + (vy - fy) * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
             x, y = self.off_segment(x, y, qx, qy, nx, ny, r)
-            vx, vy, w = segment_bounce(x, y, vx, vy, *ends, e, w, r, m, inertia, beta)
+            vx, vy, w = moving_segment_bounce(x, y, vx, vy, *ends, fx, fy, e, w, r, m, inertia, beta)
             responded = True
         return x, y, vx, vy, w, responded
 
@@ -233,27 +240,32 @@ class FramePolicy(Policy):
 
     def _segments(self, t, prev, pos, paths, tally, events) -> None:
         """Discs cutting a segment at ``pos``; updates ``pos`` and the paths in place."""
-        rows, cols = segments_cut(pos, self.shapes, tally.counts)
+        shapes = self.shapes
+        seg_a, seg_b, ends = shapes.segments_at(t)  # where the segments are at the frame
+        rows, cols = segments_cut(pos, shapes, tally.counts, (seg_a, seg_b))
         if not len(rows):
             return
-        shapes = self.shapes
         vel, last, spins = paths.velocities, paths.last_collision, paths.spins
-        radius, ends = shapes.radius, shapes.seg_ends
+        radius, seg_speeds = shapes.radius, shapes.seg_speeds if shapes.seg_moving else None
         e0, per_group, table, group, tc = shapes.e, shapes.per_group, shapes.e_table, shapes.e_group, shapes.tc
         rough, beta = shapes.rough, shapes.beta
         log = tally.log
-        by_disc: dict[int, list[tuple]] = {}
+        by_disc: dict[int, list[int]] = {}
         for i, k in zip(rows.tolist(), cols.tolist()):
-            by_disc.setdefault(i, []).append(ends[k])
-        for i, hits in by_disc.items():
+            by_disc.setdefault(i, []).append(k)
+        for i, cut in by_disc.items():
             x, y = pos[i].tolist()
             wx, wy = vel[i].tolist()
             e = restitution(i, i, t, e0, per_group, table, group, tc, last)
             w0 = float(spins[i])
             turn = (w0, shapes.masses[i], shapes.inertias[i], beta)
-            x, y, vx, vy, w, responded = self.off_segments(x, y, wx, wy, prev[i], hits, radius[i], e, turn)
+            hits, speeds = [ends[k] for k in cut], None if seg_speeds is None else [seg_speeds[k] for k in cut]
+            x, y, vx, vy, w, responded = self.off_segments(x, y, wx, wy, prev[i], hits, radius[i], e, turn, speeds)
             if responded:
-                if e != 1.0 or rough:
+                if speeds is not None:  # what the bounces took, in the segments' frames (a moving one does work)
+                    fx, fy = speeds[0]
+                    tally.dissipated += kinetic_loss(shapes.masses[i], wx - fx, wy - fy, vx - fx, vy - fy)
+                elif e != 1.0 or rough:
                     tally.dissipated += kinetic_loss(shapes.masses[i], wx, wy, vx, vy)
                 if rough:
                     paths.spin_to(i, t)
@@ -384,29 +396,34 @@ class Revert(FramePolicy):
         pos[rows] = prev[rows]
         return pos
 
-    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0)):
+    def off_segments(self, x, y, vx, vy, previous, hits, r, e=1.0, turn=(0.0, 1.0, math.inf, -1.0), speeds=None):
+        # A moving segment stays where it is at the frame; the disc goes back, and is tested and bounced in the
+        # segment's frame.
         reverted = False
         responded = False
         w, m, inertia, beta = turn
-        for ends in hits:
+        for k, ends in enumerate(hits):
+            sx, sy = (0.0, 0.0) if speeds is None else speeds[k]
             qx, qy = closest_point_on_segment(x, y, *ends)
             nx, ny = x - qx, y - qy
             if not reverted:
                 px, py = previous.tolist()
                 bx, by = closest_point_on_segment(px, py, *ends)
-                if vx * (px - bx) + vy * (py - by) < 0.0:  # approaching there: reflect at the restored place
+                if (vx - sx) * (px - bx) + (vy - sy) * (
+                    py - by
+                ) < 0.0:  # approaching there: reflect at the restored place
                     x, y, nx, ny = px, py, px - bx, py - by
                     reverted = True
-                elif vx * nx + vy * ny < 0.0:  # approaching only at the frame: restore, keep the frame's normal
+                elif (vx - sx) * nx + (vy - sy) * ny < 0.0:  # approaching only at the frame: restore, keep its normal
                     fx, fy = x, y
                     x, y = px, py
                     reverted = True
-                    vx, vy, w = segment_bounce(fx, fy, vx, vy, *ends, e, w, r, m, inertia, beta)
+                    vx, vy, w = moving_segment_bounce(fx, fy, vx, vy, *ends, sx, sy, e, w, r, m, inertia, beta)
                     responded = True
                     continue
-            if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
+            if (vx - sx) * nx + (vy - sy) * ny >= 0.0:  # receding (or the centre is on the segment): leave it
                 continue
-            vx, vy, w = segment_bounce(x, y, vx, vy, *ends, e, w, r, m, inertia, beta)
+            vx, vy, w = moving_segment_bounce(x, y, vx, vy, *ends, sx, sy, e, w, r, m, inertia, beta)
             responded = True
         return x, y, vx, vy, w, responded
 

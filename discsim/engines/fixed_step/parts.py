@@ -18,7 +18,8 @@ very source (``discsim._compiled.compile_from_source``), so the two cannot drift
   or the pair of groups', 1 within the TC time) and the kinetic energy it takes from one disc;
 - :func:`wall_bounce`, :func:`segment_bounce` and :func:`rough_pair`: a response with roughness (the collision
   law's :func:`~discsim.physics.laws.rough_impulse` after its normal impulse, as the event-driven loop applies
-  it), :func:`spin_loss` the rotational energy it takes from one disc.
+  it), :func:`spin_loss` the rotational energy it takes from one disc; :func:`moving_segment_bounce`: a bounce off a
+  moving segment, in its frame.
 
 The free flight, the collision law and the times of impact are the physics parts themselves
 (:mod:`discsim.physics.dynamics`, :mod:`discsim.physics.laws`, :mod:`discsim.physics.sources`).
@@ -36,6 +37,7 @@ __all__ = [
     "cell_span",
     "impulse_virial",
     "kinetic_loss",
+    "moving_segment_bounce",
     "nearest_image",
     "push_off_segment",
     "restitution",
@@ -327,3 +329,25 @@ def segment_bounce(
         qx, qy = closest_point_on_segment(x, y, ax, ay, bx, by)
         ux, uy, w = _rough_bounce(qx - x, qy - y, vx, vy, ux, uy, w, r, m, inertia, beta)
     return ux, uy, w
+
+
+def moving_segment_bounce(
+    x: float, y: float, vx: float, vy: float, ax: float, ay: float, bx: float, by: float, fx: float, fy: float,
+    e: float, w: float, r: float, m: float, inertia: float, beta: float,
+) -> tuple[float, float, float]:  # fmt: skip
+    """A bounce of a disc at ``(x, y)`` off segment ``a``-``b`` (where it is at the frame) moving at ``(fx, fy)``
+    (length / time): :func:`segment_bounce` of the velocity relative to the segment, the segment's velocity added
+    back, as the event-driven loop bounces a disc in a moving segment's frame; a fixed segment's is
+    :func:`segment_bounce`'s, to the bit.
+
+    Returns:
+        ``(vx, vy, w)``: the velocity and spin after.
+
+    Example:
+        >>> moving_segment_bounce(0.0, 0.5, 0.0, 0.0, -3.0, 0.0, 3.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.5, 1.0, 0.5, -1.0)
+        (0.0, 2.0, 0.0)
+    """
+    if fx == 0.0 and fy == 0.0:
+        return segment_bounce(x, y, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, beta)
+    ux, uy, w = segment_bounce(x, y, vx - fx, vy - fy, ax, ay, bx, by, e, w, r, m, inertia, beta)
+    return ux + fx, uy + fy, w

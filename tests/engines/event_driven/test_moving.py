@@ -122,9 +122,9 @@ def test_queries_and_added_discs_see_the_segment_where_it_is_now():
             "segments[0]",
         ),
         (
-            lambda: ds.FixedStep(ball(2, 2), BOX, segments=[ds.Segment((5, 0), (5, 9), (1, 0))]),
+            lambda: ds.FixedStep(ball(2, 2), BOX, segments=[ds.Segment((5, 0), (5, 9), (1, 0))], policy="bisect"),
             InvalidArgumentError,
-            "FixedStep moves no segment",
+            "segments[0] Segment([5.0, 0.0], [5.0, 9.0], velocity=[1.0, 0.0]) moves: policy 'bisect'",
         ),
         (
             lambda: ds.EventDriven(ball(5.2, 2), BOX, segments=[ds.Segment((5, 0), (5, 9), (1, 0))]),

@@ -154,7 +154,7 @@ def test_energy_plus_dissipated_is_constant_under_drag_with_resolve(gravity):
 @pytest.mark.parametrize("policy", FRAME_POLICIES)
 def test_the_terminal_fall_case_compares_pit_with_pic_under_drag(policy):
     case = ds.scenarios.terminal_fall()
-    assert [c.name for c in ds.scenarios.law_cases()] == ["bouncing_ball", "terminal_fall"]
+    assert [c.name for c in ds.scenarios.law_cases()][:2] == ["bouncing_ball", "terminal_fall"]
     g, gamma = -case.laws["gravity"][1], case.laws["drag"]
     h0 = float(case.discs.positions[0, 1] - case.discs.radii[0])
     pic = ds.EventDriven(case.discs, case.box, **case.laws).run(until=case.until)

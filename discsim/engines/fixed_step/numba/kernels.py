@@ -67,6 +67,7 @@ _parts = compile_from_source(
         parts._rough_bounce,
         parts.wall_bounce,
         parts.segment_bounce,
+        parts.moving_segment_bounce,
     ),
     jit,
 )
@@ -83,6 +84,7 @@ _spin_loss = _parts[parts.spin_loss]
 _rough_pair = _parts[parts.rough_pair]
 _wall_bounce = _parts[parts.wall_bounce]
 _segment_bounce = _parts[parts.segment_bounce]
+_moving_segment_bounce = _parts[parts.moving_segment_bounce]
 
 #: The compiled policies by name: the ``policy`` argument of :func:`frames`.
 POLICY_CODES = {"resolve": 0, "revert": 1, "separate": 2}
@@ -200,38 +202,43 @@ def _off_segments(policy, x, y, vx, vy, px, py, segments, cut, r, e, w, m, inert
 
     ``FramePolicy.off_segments`` (``"resolve"``, ``"separate"``) and ``Revert.off_segments``; ``(px, py)``
     is the disc's position at the previous frame; ``w``, ``m``, ``inertia``: its spin, mass, moment of inertia;
-    ``beta``: the roughness.
+    ``beta``: the roughness. ``segments`` ``(S, 6)``: the ends where they are at the frame and the velocities (a
+    moving segment is approached, and bounces the disc, in its frame; ``"revert"`` tests it where it is at the frame).
     """
     responded = False
     reverted = False
     for s in cut:
         ax, ay, bx, by = segments[s, 0], segments[s, 1], segments[s, 2], segments[s, 3]
+        sx, sy = segments[s, 4], segments[s, 5]
         qx, qy = _closest_point(x, y, ax, ay, bx, by)
         nx, ny = x - qx, y - qy
         if policy == REVERT and not reverted:
             cx, cy = _closest_point(px, py, ax, ay, bx, by)
-            if vx * (px - cx) + vy * (py - cy) < 0.0:  # approaching there: reflect at the restored place
+            if (vx - sx) * (px - cx) + (vy - sy) * (py - cy) < 0.0:  # approaching there: reflect at the restored place
                 x, y, nx, ny = px, py, px - cx, py - cy
                 reverted = True
-            elif vx * nx + vy * ny < 0.0:  # approaching only at the frame: restore, keep the frame's normal
+            elif (vx - sx) * nx + (vy - sy) * ny < 0.0:  # approaching only at the frame: restore, keep its normal
                 fx, fy = x, y
                 x, y = px, py
                 reverted = True
-                vx, vy, w = _segment_bounce(fx, fy, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, beta)
+                vx, vy, w = _moving_segment_bounce(fx, fy, vx, vy, ax, ay, bx, by, sx, sy, e, w, r, m, inertia, beta)
                 responded = True
                 continue
-        if vx * nx + vy * ny >= 0.0:  # receding (or the centre is on the segment): leave it
+        if (vx - sx) * nx + (vy - sy) * ny >= 0.0:  # receding (or the centre is on the segment): leave it
             continue
         if policy == SEPARATE:
             x, y = _push_off_segment(x, y, qx, qy, nx, ny, r, cpython_hypot(nx, ny))
-        vx, vy, w = _segment_bounce(x, y, vx, vy, ax, ay, bx, by, e, w, r, m, inertia, beta)
+        vx, vy, w = _moving_segment_bounce(x, y, vx, vy, ax, ay, bx, by, sx, sy, e, w, r, m, inertia, beta)
         responded = True
     return x, y, vx, vy, w, responded
 
 
 @jit
-def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws, turning):
-    """Discs cutting a segment, each answered by :func:`_off_segments`; returns ``(k, ev_n, ev_f)``."""
+def _segments(
+    policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws, turning, moving
+):
+    """Discs cutting a segment (``segments`` ``(S, 6)`` where they are at the frame, see :func:`_segments_at`), each
+    answered by :func:`_off_segments`; ``moving``: some segment moves. Returns ``(k, ev_n, ev_f)``."""
     _, _, _, _, e0, per_group, table, group, tc, last, lost = laws
     beta, inertia, spins, angles, angle_t = turning
     rough = beta != -1.0
@@ -252,7 +259,10 @@ def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t
             policy, x, y, wx, wy, prev[i, 0], prev[i, 1], segments, cut[:m], r, e, w0, masses[i], inertia[i], beta
         )
         if responded:
-            if e != 1.0 or rough:
+            if moving:  # what the bounces took, in the first segment's frame (FramePolicy._segments)
+                fx, fy = segments[cut[0], 4], segments[cut[0], 5]
+                lost[0] += _kinetic_loss(masses[i], wx - fx, wy - fy, vx - fx, vy - fy)
+            elif e != 1.0 or rough:
                 lost[0] += _kinetic_loss(masses[i], wx, wy, vx, vy)
             if rough:
                 _spin_to(i, t, spins, angles, angle_t)
@@ -267,6 +277,28 @@ def _segments(policy, pos, prev, vel, radii, masses, segments, ref_pos, ref_t, t
             ev_n, ev_f = _log_wall(ev_n, ev_f, k, frame, i, x, y, vx, vy)
             k += 1
     return k, ev_n, ev_f
+
+
+@jit
+def _moves(segments):
+    """Whether some segment of ``segments`` ``(S, 6)`` has a velocity."""
+    for s in range(len(segments)):
+        if segments[s, 4] != 0.0 or segments[s, 5] != 0.0:
+            return True
+    return False
+
+
+@jit
+def _segments_at(segments, t):
+    """``segments`` ``(S, 6)`` (ends at time 0, velocities) where they are at time ``t``: ``p0 + velocity t``, as
+    :meth:`~discsim.engines.fixed_step.arrays.Shapes.segments_at` computes them."""
+    out = np.empty_like(segments)
+    for s in range(len(segments)):
+        vx, vy = segments[s, 4], segments[s, 5]
+        out[s, 0], out[s, 1] = segments[s, 0] + vx * t, segments[s, 1] + vy * t
+        out[s, 2], out[s, 3] = segments[s, 2] + vx * t, segments[s, 3] + vy * t
+        out[s, 4], out[s, 5] = vx, vy
+    return out
 
 
 @jit
@@ -610,9 +642,11 @@ def _frame(
         )  # fmt: skip
     if len(segments):
         counts[C_SEGMENT_TESTS] += n * len(segments)
+        moving = _moves(segments)
+        here = _segments_at(segments, t) if moving else segments
         k, ev_n, ev_f = _segments(
-            policy, pos, frame_pos, vel, radii, masses, segments, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws,
-            turning,
+            policy, pos, frame_pos, vel, radii, masses, here, ref_pos, ref_t, t, ev_n, ev_f, k, frame, laws,
+            turning, moving,
         )  # fmt: skip
     counts[C_WALL_HITS] += k - first
     if not all_pairs and (len(list_pos) == 0 or _stale(pos, list_pos, periodic, width, height, limit2)):
@@ -659,7 +693,8 @@ def frames(policy, times, scene, paths, broad, counts, overlap, virial, laws, tu
     Args:
         policy: :data:`POLICY_CODES`. times ``(F,)``: the frames' times.
         scene: ``(radii, masses, periodic, width, height, segments, group, blocked, filtering)``:
-            per-disc radii and masses, the box, the segments' end points ``(S, 4)``, the collision
+            per-disc radii and masses, the box, the segments' end points at time 0 and velocities ``(S, 6)``
+            (``x0, y0, x1, y1, vx, vy``), the collision
             filter (``Scene.group``, ``Scene.blocked``, ``Scene.filtering``).
         paths: ``(ref_pos, vel, ref_t, images, frame_pos)``, as in ``Paths``.
         broad: ``(all_pairs, list_pos, list_i, list_j, limit2, reach2, nx, ny, per_x, per_y)``: every

@@ -52,7 +52,7 @@ def _scene_arrays(shapes: Shapes) -> tuple:
         bool(box.periodic),
         float(box.width),
         float(box.height),
-        np.array(shapes.seg_ends, dtype=np.float64).reshape(-1, 4),
+        np.concatenate([np.array(shapes.seg_ends, dtype=np.float64).reshape(-1, 4), shapes.seg_v], axis=1),
         np.ascontiguousarray(scene.group, dtype=np.int64),
         np.ascontiguousarray(scene.blocked, dtype=np.bool_),
         bool(scene.filtering),

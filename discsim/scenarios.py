@@ -557,22 +557,17 @@ def paddle_tunnel(speed: float = 20.0, paddle_speed: float = 10.0) -> Scenario:
         >>> case.laws["segments"], case.frame_rate, case.until
         ((Segment([14.5, 3.0], [14.5, 7.0], velocity=[-10.0, 0.0]),), 30.0, 0.6)
     """
-    r = 0.2
-    discs = Discs([[2.0, 5.0]], [[float(speed), 0.0]], radii=r)
+    discs = Discs([[2.0, 5.0]], [[float(speed), 0.0]], radii=0.2)
     paddle = Segment((14.5, 3.0), (14.5, 7.0), velocity=(-float(paddle_speed), 0.0))
     return Scenario(
-        discs,
-        Box(20.0, 10.0),
-        frame_rate=30.0,
-        until=0.6,
-        name="paddle_tunnel",
+        discs, Box(20.0, 10.0), frame_rate=30.0, until=0.6, name="paddle_tunnel",
         description=(
             "A fast disc and a thin moving paddle close 1 per frame, more than the disc's diameter: PIT's frames "
             "straddle the crossing and the disc tunnels through the paddle, which PIC bounces it off at the exact "
             "time."
         ),
         laws={"segments": (paddle,)},
-    )
+    )  # fmt: skip
 
 
 def law_cases() -> list[Scenario]:

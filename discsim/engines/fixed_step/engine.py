@@ -82,6 +82,21 @@ DEFAULT_BISECT_FRACTION = 1e-6
 MOVING_SEGMENT_POLICIES = ("resolve", "revert", "separate")
 
 
+def _frame_step(frame_rate, dt) -> tuple[float, float, bool]:
+    """``(dt, frame rate, whether the rate was given)`` from ``frame_rate`` or ``dt`` (the default rate if neither),
+    refusing both when they disagree."""
+    if dt is None:
+        rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
+        return 1.0 / rate, rate, True
+    step = positive_finite("dt", dt)
+    if frame_rate is not None:
+        rate = positive_finite("frame_rate", frame_rate)
+        if not math.isclose(rate * step, 1.0, rel_tol=1e-12):
+            msg = f"give frame_rate or dt, not both: frame_rate={frame_rate!r} but dt={dt!r}"
+            raise InvalidArgumentError(msg)
+    return step, 1.0 / step, False
+
+
 def _moving_segments(scene: Scene, laws: Laws, policy: str) -> Scene:
     """``scene``, unless a segment moves where this engine cannot move it: under gravity, drag or roughness (as
     ``EventDriven`` refuses them), or with a policy other than :data:`MOVING_SEGMENT_POLICIES` (``"bisect"`` and
@@ -240,17 +255,7 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
         drag: float = 0.0,
         sensors=None,
     ):
-        if dt is None:
-            rate = DEFAULT_FRAME_RATE if frame_rate is None else positive_finite("frame_rate", frame_rate)
-            step, by_rate = 1.0 / rate, True
-        else:
-            step = positive_finite("dt", dt)
-            if frame_rate is not None:
-                rate = positive_finite("frame_rate", frame_rate)
-                if not math.isclose(rate * step, 1.0, rel_tol=1e-12):
-                    msg = f"give frame_rate or dt, not both: frame_rate={frame_rate!r} but dt={dt!r}"
-                    raise InvalidArgumentError(msg)
-            rate, by_rate = 1.0 / step, False
+        step, rate, by_rate = _frame_step(frame_rate, dt)
         if policy not in POLICIES:
             msg = f"policy must be one of {list(POLICIES)}, got {policy!r}"
             raise InvalidArgumentError(msg)

@@ -1,0 +1,35 @@
+"""Sensors in the event-driven engine, attacked (issue 28 review): edits in callbacks at the moment of a crossing,
+trip wires on a periodic box's edge. Every test runs on both backends (the directory's conftest)."""
+
+import numpy as np
+import pytest
+
+import discsim as ds
+from discsim.events import ENTER, SENSED
+
+Sensor = ds.Sensor
+
+
+def crossings(sim):
+    """``[(time, "enter" | "leave", disc, sensor), ...]`` from the log."""
+    ev = sim.events
+    ev = ev[np.isin(ev["kind"], SENSED)]
+    return [(float(e["time"]), "enter" if e["kind"] == ENTER else "leave", int(e["i"]), int(e["j"])) for e in ev]
+
+
+def test_a_disc_put_back_where_it_is_as_it_enters_a_rectangle_enters_once():
+    # The disc enters [4, 6] x [4, 6] at t = 3 with its centre exactly on the edge x = 4. A callback that sets its
+    # position to where it is must not make it outside again (it entered again at once, with no leave between).
+    sim = ds.EventDriven(ds.Discs([[1.0, 5.3]], [[1.0, 0.0]], radii=0.2), ds.Box(10.0, 10.0),
+                         sensors=[Sensor.rectangle((4.0, 4.0), (6.0, 6.0))])  # fmt: skip
+    calls = []
+
+    def put_back(sim, crossing):
+        calls.append(crossing.time)
+        if len(calls) == 1:
+            sim.set_positions([crossing.i], sim.positions[[crossing.i]])
+
+    sim.on("enter", put_back)
+    sim.run(until=6.0)
+    assert [(k, t) for t, k, *_ in crossings(sim)] == [("enter", 3.0), ("leave", 5.0)]
+    assert calls == [3.0]

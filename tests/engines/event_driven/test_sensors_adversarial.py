@@ -71,3 +71,10 @@ def test_a_disc_leaving_a_region_on_a_periodic_box_edge_is_reported_leaving():
     found = crossings(sim)
     assert [k for _, k, *_ in found] == ["leave", "enter", "leave", "enter", "leave"]
     assert [t for t, *_ in found] == pytest.approx([2.0, 9.0, 12.0, 19.0, 22.0], rel=1e-14)
+
+
+def test_crossings_of_two_sensors_at_one_instant_come_in_the_sensors_order():
+    sensors = [Sensor.circle((5.0, 5.0), 1.0), Sensor.circle((5.0, 5.0), 1.0)]
+    sim = ds.EventDriven(ds.Discs([[1.0, 5.3]], [[1.0, 0.0]], radii=0.2), ds.Box(10.0, 10.0), sensors=sensors)
+    sim.run(until=6.0)
+    assert [(k, j) for _, k, _, j in crossings(sim)] == [("enter", 0), ("enter", 1), ("leave", 0), ("leave", 1)]

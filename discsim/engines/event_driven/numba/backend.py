@@ -412,10 +412,12 @@ class NumbaBackend(CompiledReads):
         else:
             x, y, _, _ = self._law_of_motion.advance(*args)
         cell = int(self._cell[k])
+        moved = position is not None and (float(position[0]), float(position[1])) != (x, y)
         if position is not None:
             x, y = float(position[0]), float(position[1])
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
-        if position is not None and self.scene.sensors:  # moved: its sides of the sensors are where it is now
+        if moved and self.scene.sensors:  # its sides of the sensors are where it is now (put back where it is, a
+            # centre on an edge keeps its side: taken afresh, it was outside and entered again at once)
             sensors, n = self.scene.sensors, len(rec)
             self._rest[n + k * len(sensors) : n + (k + 1) * len(sensors)] = inside_table(sensors, [[x, y]])[0]
         held: list[int] = []

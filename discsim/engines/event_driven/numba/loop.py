@@ -220,7 +220,8 @@ def predict(
                 xi, yi, vxi, vyi, axi, ayi, drag, seg[k, 4], seg[k, 0], seg[k, 1], seg[k, 2], seg[k, 3],
                 rest[n + i * ((rest.shape[0] - n) // n) + int(seg[k, 5])] != 0,
             )  # fmt: skip
-            if ts < best:
+            if ts < best or (ts == best and kind != SENSOR):  # a tie with the box's edge: sensed first (the wrap
+                # after would take the side unseen); among sensors, the first
                 best, kind, other = ts, SENSOR, k
         elif k != -2 - exclude:  # not the segment just left
             if LAWS and (seg[k, 6] != 0.0 or seg[k, 7] != 0.0):  # a moving segment: where it is now, in its frame

@@ -80,6 +80,21 @@ class PistonRun:
         return self
 
     # --- for the engine ----------------------------------------------------------------------
+    def _check_piston_edit(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
+        """Refuse, before anything changes, new ``positions`` (None: where they are) and ``velocities`` of discs
+        ``indices`` that would put a disc above the piston or give the gas the energy to lift it out of the box
+        (:func:`check_room`); nothing without a piston."""
+        if self.scene.piston is None:
+            return
+        now = self.snapshot()
+        places, speeds = now.positions.copy(), now.velocities.copy()
+        if positions is not None:
+            places[indices] = positions
+        speeds[indices] = velocities
+        height, velocity, _, pressure = self._piston_now()
+        discs = Discs(places, speeds, now.radii, now.masses, now.groups, now.spins, now.inertia)
+        check_room(self.scene.piston, self.box, discs, height, velocity, pressure)
+
     def _piston_now(self) -> tuple[float, float, int, float]:
         """The piston's height, velocity, impacts and pressure now (a piston runs on the compiled loop's backend)."""
         backend: Any = self._backend

@@ -1,0 +1,44 @@
+"""An adversarial review of the piston (issue 28, item 2): edits that would put a disc above it, give the gas the
+energy to lift it out of the box, or leave a finite-mass piston over no disc are refused before anything changes,
+and the engine stays usable; both backends (``every_backend``, the directory's conftest; the Python one runs the
+compiled loop's source, interpreted)."""
+
+import pytest
+
+import discsim as ds
+from discsim.errors import InvalidArgumentError, OutsideBoxError
+
+BOX = ds.Box(10.0, 10.0)
+
+
+def two_discs():
+    discs = ds.Discs([[3.0, 1.0], [7.0, 1.0]], [[0.0, 0.5], [0.3, -0.2]], radii=0.5)
+    return ds.EventDriven(discs, BOX, piston=ds.Piston(mass=1.0, pressure=1.0, height=5.0))
+
+
+def unchanged(sim, positions, velocities, piston):
+    assert sim.positions.tolist() == positions and sim.velocities.tolist() == velocities
+    assert (sim.piston.height, sim.piston.velocity, sim.piston.hits) == piston
+
+
+def state(sim):
+    p = sim.piston
+    return sim.positions.tolist(), sim.velocities.tolist(), (p.height, p.velocity, p.hits)
+
+
+def test_edits_that_would_put_a_disc_above_the_piston_or_lift_it_out_of_the_box_are_refused():
+    sim = two_discs().run(until=0.5)
+    before = state(sim)
+    with pytest.raises(OutsideBoxError, match="disc 0's top"):  # in the box, but above the piston at 5
+        sim.set_positions([0], [[3.0, 7.0]])
+    unchanged(sim, *before)
+    with pytest.raises(InvalidArgumentError, match="could rise to"):  # K = 450: the piston could reach 5 + 45
+        sim.set_velocities([0], [[0.0, 30.0]])
+    unchanged(sim, *before)
+    with pytest.raises(InvalidArgumentError, match="could rise to"):
+        sim.apply_impulse([1], [[0.0, -30.0]])
+    unchanged(sim, *before)
+    assert len(sim.events) == sim.counts["wall_hits"] + sim.counts["collisions"]  # no SET record logged
+    sim.set_velocities([0], [[0.0, 2.0]]).run(until=3.0)  # still usable: a fair edit runs on
+    assert sim.piston.height <= BOX.height
+    sim._check()

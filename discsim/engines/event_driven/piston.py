@@ -110,6 +110,9 @@ class PistonRun:
         asked_pressure, asked_velocity = self._piston_asked
         pressure = pressure if asked_pressure is None else asked_pressure
         velocity = velocity if asked_velocity is None else asked_velocity
+        if not self.scene.piston.kinematic and not len(discs):
+            msg = "a piston of finite mass needs discs under it: with none it would fall for ever"
+            raise InvalidArgumentError(msg)
         check_room(self.scene.piston, self.box, discs, height, velocity, pressure)
         return np.array([height, velocity, 0.0, float(hits), pressure])
 

@@ -3,6 +3,8 @@ energy to lift it out of the box, or leave a finite-mass piston over no disc are
 and the engine stays usable; both backends (``every_backend``, the directory's conftest; the Python one runs the
 compiled loop's source, interpreted)."""
 
+import math
+
 import pytest
 
 import discsim as ds
@@ -42,3 +44,17 @@ def test_edits_that_would_put_a_disc_above_the_piston_or_lift_it_out_of_the_box_
     sim.set_velocities([0], [[0.0, 2.0]]).run(until=3.0)  # still usable: a fair edit runs on
     assert sim.piston.height <= BOX.height
     sim._check()
+
+
+def test_removing_every_disc_under_a_finite_mass_piston_is_refused():
+    sim = two_discs().run(until=0.5)
+    before = state(sim)
+    with pytest.raises(InvalidArgumentError, match="needs discs under it"):  # it would fall through the floor
+        sim.remove_discs([0, 1])
+    unchanged(sim, *before)
+    sim.remove_discs([0]).run(until=3.0)  # one left holds it up
+    assert len(sim.discs) == 1 and 0.0 < sim.piston.height <= BOX.height
+    sim._check()
+    lid = ds.Piston(mass=math.inf, pressure=0.0, height=8.0, velocity=0.5)  # a kinematic lid needs no gas
+    sim = ds.EventDriven(ds.Discs([[5.0, 2.0]], [[0.0, 1.0]], radii=0.5), BOX, piston=lid)
+    assert len(sim.remove_discs([0]).discs) == 0

@@ -15,7 +15,7 @@ import numpy as np
 
 from discsim.engines.event_driven.protocol import Backend
 from discsim.errors import InvalidArgumentError, OutsideBoxError
-from discsim.model import Box, Discs
+from discsim.model import OVERLAP_TOLERANCE, Box, Discs
 from discsim.piston import Piston, PistonState
 from discsim.scene import Scene
 
@@ -118,12 +118,14 @@ class PistonRun:
 
 
 def check_room(piston: Piston, box: Box, discs: Discs, height: float, velocity: float, pressure: float) -> None:
-    """Refuse ``discs`` with a top above ``piston`` at ``height``, or a gas that could lift it (at ``velocity``,
-    under ``pressure``) above the box, naming the disc or the height it could reach: energy bounds its height by
-    ``H + (K + M U^2 / 2) / F`` (``K`` the discs' kinetic energy, ``F`` the pressure times the box's width)."""
+    """Refuse ``discs`` with a top above ``piston`` at ``height`` (by more than ``OVERLAP_TOLERANCE`` of its radius,
+    as a wall), or a gas that could lift it (at ``velocity``, under ``pressure``) above the box, naming the disc or
+    the height it could reach: energy bounds its height by ``H + (K + M U^2 / 2) / F`` (``K`` the discs' kinetic
+    energy, ``F`` the pressure times the box's width)."""
     tops = discs.positions[:, 1] + discs.radii
-    if len(tops) and float(tops.max()) > height:
-        k = int(np.argmax(tops))
+    over = tops - height - OVERLAP_TOLERANCE * discs.radii  # (a disc just off the piston touches it to roundoff)
+    if len(tops) and float(over.max()) > 0.0:
+        k = int(np.argmax(over))
         msg = f"disc {k}'s top y + r = {float(tops[k])!r} is above the piston's height {height!r}"
         raise OutsideBoxError(msg)
     if piston.kinematic:

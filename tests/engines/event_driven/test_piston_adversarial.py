@@ -8,6 +8,7 @@ import math
 import pytest
 
 import discsim as ds
+from discsim.analysis.contacts import TOP
 from discsim.errors import DiscsimError, InvalidArgumentError, OutsideBoxError, TimeError
 
 BOX = ds.Box(10.0, 10.0)
@@ -108,3 +109,18 @@ def test_thermo_right_after_set_piston_does_not_average_the_old_pressure_span():
     sim.set_piston(pressure=1.0)
     with pytest.raises(TimeError):  # nothing at pressure 1 to average yet
         ds.thermo(sim)
+
+
+def test_a_piston_hit_is_a_contact_on_the_top_surface_at_the_speed_the_two_approached():
+    # The closed form of test_piston.py: M = 3 falls on a disc at rest and meets it at -sqrt(8) at height 1.5. The
+    # contact was named as the floor (surface -3: the wall nearest the disc) with speed 0 (the disc's own, not the
+    # speed of approach of disc and piston).
+    disc = ds.Discs([[5.0, 1.0]], [[0.0, 0.0]], radii=0.5)
+    sim = ds.EventDriven(disc, BOX, piston=ds.Piston(mass=3.0, pressure=0.3, height=5.5))
+    seen = []
+    sim.on("wall", lambda _, contact: seen.append(contact))
+    sim.run(until=2.9)  # the impact, not yet the floor
+    for contact in (seen[0], ds.contacts(sim)[0]):
+        assert (contact.kind, contact.surface) == ("wall", TOP)
+        assert contact.speed == pytest.approx(math.sqrt(8.0), rel=1e-14)
+        assert contact.normal.tolist() == pytest.approx([0.0, 1.0]) and contact.point.tolist() == [5.0, 1.5]

@@ -192,6 +192,9 @@ def contacts_of(events, velocities, masses, radii, box, segments=()) -> Contacts
             hit = nearest == 4 + s
             if seg.moving and hit.any():
                 speed[walls[hit]] -= nrm[hit] @ seg.velocity
+        piston = walls[np.isfinite(ev["yj"][walls])]  # a piston's impact (its height and velocity after in yj, vyj)
+        surface[piston], kind[piston] = TOP, "wall"
+        speed[piston] = ev["vyj"][piston] - ev["vyi"][piston]  # (elastic: approached as fast as they part)
     point = ri + normal * radii[i][:, None]
     if box.periodic:
         point = box.wrap(point)
@@ -239,6 +242,8 @@ def contact_of_record(rec, i: int, j: int, before_i, before_j, masses, radii, bo
         if nearest >= 4 and segments[nearest - 4].moving:  # its speed of approach in the segment's frame
             u = segments[nearest - 4].velocity
             speed -= nx * float(u[0]) + ny * float(u[1])
+        if math.isfinite(float(rec["yj"])):  # a piston's impact (its height and velocity after in yj, vyj)
+            kind, surface, speed = "wall", TOP, float(rec["vyj"]) - vyi  # (elastic: approached as fast as they part)
     px, py = xi + nx * ri, yi + ny * ri
     if box.periodic:
         px, py = (float(v) for v in box.wrap(np.array([px, py])))

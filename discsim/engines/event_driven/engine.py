@@ -266,6 +266,7 @@ class EventDriven(PistonRun, Turning, RunStops, Engine):
         return self._units() + self._edits
 
     def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
+        self._check_piston_edit(indices, positions, velocities)  # before any disc changes
         set_disc = self._backend.set_disc
         for k, i in enumerate(indices.tolist()):
             vx, vy = velocities[k].tolist()

@@ -15,7 +15,7 @@ import numpy as np
 
 from discsim.engines.event_driven.protocol import Backend
 from discsim.errors import InvalidArgumentError, OutsideBoxError
-from discsim.model import Box, Discs
+from discsim.model import OVERLAP_TOLERANCE, Box, Discs
 from discsim.piston import Piston, PistonState
 from discsim.scene import Scene
 
@@ -80,6 +80,21 @@ class PistonRun:
         return self
 
     # --- for the engine ----------------------------------------------------------------------
+    def _check_piston_edit(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
+        """Refuse, before anything changes, new ``positions`` (None: where they are) and ``velocities`` of discs
+        ``indices`` that would put a disc above the piston or give the gas the energy to lift it out of the box
+        (:func:`check_room`); nothing without a piston."""
+        if self.scene.piston is None:
+            return
+        now = self.snapshot()
+        places, speeds = now.positions.copy(), now.velocities.copy()
+        if positions is not None:
+            places[indices] = positions
+        speeds[indices] = velocities
+        height, velocity, _, pressure = self._piston_now()
+        discs = Discs(places, speeds, now.radii, now.masses, now.groups, now.spins, now.inertia)
+        check_room(self.scene.piston, self.box, discs, height, velocity, pressure, -self.laws.gravity[1])
+
     def _piston_now(self) -> tuple[float, float, int, float]:
         """The piston's height, velocity, impacts and pressure now (a piston runs on the compiled loop's backend)."""
         backend: Any = self._backend
@@ -95,6 +110,9 @@ class PistonRun:
         asked_pressure, asked_velocity = self._piston_asked
         pressure = pressure if asked_pressure is None else asked_pressure
         velocity = velocity if asked_velocity is None else asked_velocity
+        if not self.scene.piston.kinematic and not len(discs):
+            msg = "a piston of finite mass needs discs under it: with none it would fall for ever"
+            raise InvalidArgumentError(msg)
         check_room(self.scene.piston, self.box, discs, height, velocity, pressure, -self.laws.gravity[1])
         return np.array([height, velocity, 0.0, float(hits), pressure])
 
@@ -102,14 +120,15 @@ class PistonRun:
 def check_room(
     piston: Piston, box: Box, discs: Discs, height: float, velocity: float, pressure: float, fall: float = 0.0
 ) -> None:
-    """Refuse ``discs`` with a top above ``piston`` at ``height``, or a gas that could lift it (at ``velocity``,
-    under ``pressure``) above the box, naming the disc or the height it could reach: energy bounds its height by
-    ``H + (K + V + M U^2 / 2) / F`` (``K`` the discs' kinetic energy, ``V = g sum m (y - r)`` their potential energy
-    above the floor under gravity ``g = fall`` down along y, ``F`` the pressure times the box's width plus the
-    piston's weight ``M g``)."""
+    """Refuse ``discs`` with a top above ``piston`` at ``height`` (by more than ``OVERLAP_TOLERANCE`` of its radius,
+    as a wall), or a gas that could lift it (at ``velocity``, under ``pressure``) above the box, naming the disc or
+    the height it could reach: energy bounds its height by ``H + (K + V + M U^2 / 2) / F`` (``K`` the discs' kinetic
+    energy, ``V = g sum m (y - r)`` their potential energy above the floor under gravity ``g = fall`` down along y,
+    ``F`` the pressure times the box's width plus the piston's weight ``M g``)."""
     tops = discs.positions[:, 1] + discs.radii
-    if len(tops) and float(tops.max()) > height:
-        k = int(np.argmax(tops))
+    over = tops - height - OVERLAP_TOLERANCE * discs.radii  # (a disc just off the piston touches it to roundoff)
+    if len(tops) and float(over.max()) > 0.0:
+        k = int(np.argmax(over))
         msg = f"disc {k}'s top y + r = {float(tops[k])!r} is above the piston's height {height!r}"
         raise OutsideBoxError(msg)
     if piston.kinematic:

@@ -1,4 +1,5 @@
-"""The sensors in discsim.plot's pictures (matplotlib): drawn as the viewer (:mod:`discsim.view`) draws them."""
+"""The sensors and segments in discsim.plot's pictures (matplotlib): drawn as the viewer (:mod:`discsim.view`) draws
+them (a moving segment where it is at the time drawn)."""
 
 from __future__ import annotations
 
@@ -6,10 +7,12 @@ import math
 from typing import Any
 
 import matplotlib.colors
+import numpy as np
+from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
-__all__ = ["SENSOR_COLOUR", "draw_sensors"]
+__all__ = ["SENSOR_COLOUR", "draw_segments", "draw_sensors", "segment_lines"]
 
 #: Dark goldenrod, the viewer's too: apart from tab10 (the discs) and viridis (speeds).
 SENSOR_COLOUR = "#b8860b"
@@ -44,3 +47,19 @@ def draw_sensors(ax, sensors, box) -> None:
                 zorder=1,
                 gid=f"{gid} inside",
             )
+
+
+def segment_lines(segments, time: float) -> list[np.ndarray]:
+    """Each segment's end points ``(2, 2)`` at ``time``: a moving one where :meth:`Segment.at` puts it
+    (``p0 + v t``, ``p1 + v t``), a fixed one where it is."""
+    return [np.array([moved.p0, moved.p1]) for moved in (s.at(time) for s in segments)]
+
+
+def draw_segments(ax, segments, time: float) -> LineCollection | None:
+    """Draw ``segments`` (:class:`~discsim.model.Segment` s) on ``ax`` where they are at ``time``, as one
+    ``LineCollection`` with the gid ``"segments"`` (returned: an animation moves it); None where there is none."""
+    if not len(segments):
+        return None
+    lines = LineCollection(segment_lines(segments, time), colors="0.2", linewidths=2.0, zorder=2.5, gid="segments")
+    ax.add_collection(lines)
+    return lines

@@ -7,7 +7,8 @@ the matplotlib object it made or drew on; with ``ax=None`` it makes a new figure
 
 Lengths are drawn to scale: discs are circles of their true radii and the
 axes have equal aspect.
-An engine's sensors (``sim.sensors``) are drawn under the discs, as the viewer draws them.
+An engine's sensors are drawn under the discs, as the viewer draws them; its segments where they are at the
+time drawn (a moving one from ``p0 + v t`` to ``p1 + v t``, at each frame of an animation).
 """
 
 from __future__ import annotations
@@ -27,7 +28,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
-from discsim._plot_sensors import draw_sensors
+from discsim._plot_gif import save_gif
+from discsim._plot_sensors import draw_segments, draw_sensors, segment_lines
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, COLLISION
 from discsim.model import Discs, frame_count
@@ -136,6 +138,7 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True, marks: b
         quiver = _arrows(ax, positions, velocities, _arrow_time(discs.radii, velocities), colours)
         if quiver is not None and box is not None:  # arrows end at the walls, as the discs do
             quiver.set_clip_path(Rectangle((0.0, 0.0), box.width, box.height, transform=ax.transData))
+    draw_segments(ax, getattr(sim_or_discs, "segments", ()), 0.0 if time is None else time)  # (Discs have none)
     _setup(ax, box, getattr(sim_or_discs, "sensors", ()))
     if box is None and len(positions):
         r = float(discs.radii.max())
@@ -205,6 +208,7 @@ def plot_trajectories(sim, ax=None, discs=None, *, samples: int = 400):
     starts = paths[0, chosen]
     ax.scatter(starts[:, 0], starts[:, 1], s=8, c=[colours[i] for i in chosen.tolist()], zorder=3)
     _circles(ax, paths[-1, chosen], sim.discs.radii[chosen], [colours[i] for i in chosen.tolist()], fill=False)
+    draw_segments(ax, getattr(sim, "segments", ()), float(times[-1]))  # where they are with the final outlines
     _setup(ax, sim.box, getattr(sim, "sensors", ()))
     ax.set_title(f"{type(sim).__name__}: paths over t in [{times[0]:.3g}, {times[-1]:.3g}]")
     return ax
@@ -310,6 +314,7 @@ def _draw_case_panel(ax, sim, truth, frames, times, arrow_time, contact_style, t
         vel = np.concatenate([np.column_stack([own["vxi"], own["vyi"]]), np.column_stack([own["vxj"], own["vyj"]])])
         who = np.concatenate([own["i"], own["j"]]).tolist()
         _arrows(ax, pos, vel, arrow_time, [colours[d] for d in who])
+    draw_segments(ax, getattr(sim, "segments", ()), float(times[-1]))  # where they are at the last frame
     _setup(ax, sim.box, getattr(sim, "sensors", ()))
     ax.set_xlim(limits[0], limits[1])
     ax.set_ylim(limits[2], limits[3])
@@ -507,7 +512,8 @@ def animate(
     """Animate one run, or several side by side, from their event logs.
 
     The time is written above the first panel, clear of the discs (with the frame number on a PIT frame
-    time), and the collisions of the event-driven runs are outlined from their time on (solid on their own
+    time), each run's segments are drawn where they are at each frame's time (a moving one from ``p0 + v t`` to
+    ``p1 + v t``), and the collisions of the event-driven runs are outlined from their time on (solid on their own
     panel, dashed on the others, as in :func:`plot_case`).
 
     Args:
@@ -596,11 +602,15 @@ def animate(
         if len(sims) > 1:
             for truth in truths:
                 outlines += _contact_outlines(ax, truth, colours, "-" if truth is s else "--")
+        segments = tuple(getattr(s, "segments", ()))
+        walls = draw_segments(ax, segments, float(times[0]))
+        moving = walls if any(segment.moving for segment in segments) else None  # moved at each frame
+        dynamic += [] if moving is None else [moving]
         _setup(ax, s.box, getattr(s, "sensors", ()))
         ax.set_xlim(limits[0], limits[1])
         ax.set_ylim(limits[2], limits[3])
         ax.set_title(type(s).__name__, fontsize=10, loc="left")
-        panels.append((paths, discs, quiver, speeds if arrows else None))
+        panels.append((paths, discs, quiver, speeds if arrows else None, segments, moving))
     dynamic += [patch for _, patch in outlines]
     clock = axes[0][0].text(
         1.0, 1.02, "", transform=axes[0][0].transAxes, ha="right", va="bottom", fontsize=9, zorder=6
@@ -611,13 +621,15 @@ def animate(
     fig.tight_layout()
 
     def update(k):
-        for paths, discs, quiver, speeds in panels:
+        for paths, discs, quiver, speeds, segments, moving in panels:
             here = paths[k]
             gone = ~np.isfinite(here).all(axis=1)  # not there at this time (added later, or removed)
             discs.set_offsets(np.where(gone[:, None], 1e9, here))
             if quiver is not None:
                 quiver.set_offsets(np.where(gone[:, None], 1e9, here))
                 quiver.set_UVC(*np.nan_to_num(speeds[k]).T)
+            if moving is not None:
+                moving.set_segments(segment_lines(segments, float(times[k])))
         for t, patch in outlines:
             patch.set_visible(t <= times[k])
         frame = (times[k] - times[0]) / dt if dt > 0 else math.nan
@@ -630,39 +642,12 @@ def animate(
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         if path.suffix.lower() == ".gif":
-            _save_gif(fig, update, dynamic, len(times), path, fps, dpi)
+            save_gif(fig, update, dynamic, len(times), path, fps, dpi)
             anim._draw_was_started = True  # type: ignore[attr-defined]  # saved without FuncAnimation's loop
         else:
             # matplotlib's stubs ask for an int, but the writer takes any positive frame rate.
             anim.save(str(path), writer=animation.FFMpegWriter(fps=fps), dpi=dpi)  # type: ignore[arg-type]
     return anim
-
-
-def _save_gif(fig, update, dynamic, count: int, path: Path, fps: float, dpi: int) -> None:
-    """Write the animation as a GIF by blitting: the still parts (axes, ticks, box, titles) are drawn once,
-    and each frame redraws only the moving artists onto a copy of them (Pillow writes the file)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from PIL import Image
-
-    fig.set_dpi(dpi)
-    canvas = FigureCanvasAgg(fig)
-    for artist in dynamic:
-        artist.set_animated(True)
-    canvas.draw()
-    background = canvas.copy_from_bbox(fig.bbox)
-    images: list[Any] = []
-    for k in range(count):
-        update(k)
-        canvas.restore_region(background)
-        for artist in dynamic:
-            fig.draw_artist(artist)
-        rgb = np.asarray(canvas.buffer_rgba())[..., :3]
-        image = Image.fromarray(np.ascontiguousarray(rgb))
-        # One palette for the whole movie (the first frame's): quantising each frame alone costs more.
-        images.append(image.quantize(256) if not images else image.quantize(palette=images[0]))
-    for artist in dynamic:
-        artist.set_animated(False)
-    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000.0 / fps), loop=0)
 
 
 def _figure_of(obj: Any) -> Figure:

@@ -8,14 +8,16 @@ rest stays put), so the page rebuilds every position exactly as :func:`discsim.t
 with the same floating-point operations (the same numbers, bit for bit): it holds the discs' state where the
 replay starts and each disc's state after each of its events. Where the run says how its discs turn (an
 engine's spins, rough discs' spins after each collision), a radius line on each disc shows its angle.
-The run's sensors (:class:`~discsim.sensors.Sensor`) are drawn under the discs: circles and rectangles as translucent
-outlined regions, trip wires dashed with a small arrow to their inside (the left of ``p1 - p0``); a sensor lights up
-for 0.3 s of playing after a disc enters it.
+The run's segments are drawn where they are at the time shown: a moving one (``Segment(..., velocity=v)``)
+from ``p0 + v t`` to ``p1 + v t``. The run's sensors (:class:`~discsim.sensors.Sensor`) are drawn under the
+discs: circles and rectangles as translucent outlined regions, trip wires dashed with a small arrow to their
+inside (the left of ``p1 - p0``); a sensor lights up for 0.3 s of playing after a disc enters it.
 
 In the page, ``window.discsim`` is a small API for scripts and tests: ``seek(t)``, ``time()``,
 ``positions(panel)`` (the centres last drawn, ``(N, 2)`` as nested lists), ``angles(panel)`` (the angles of
 the marks last drawn, ``(N,)``, or null where the run does not say how its discs turn), ``sensors(panel)`` (each
-sensor's ``shape``, ``params`` and whether it is ``lit`` at the time last drawn), ``play()``, ``pause()``,
+sensor's ``shape``, ``params`` and whether it is ``lit`` at the time last drawn), ``segments(panel)`` (each
+segment's end points ``[x0, y0, x1, y1]`` as last drawn), ``play()``, ``pause()``,
 ``step(frames)``, ``nextEvent()``, ``previousEvent()``, ``setSpeed(s)``, ``setFps(f)``, ``setColour(mode)``.
 A page opened as ``view.html#t=1.25`` starts at that time.
 
@@ -160,14 +162,16 @@ def _from_engine(sim, label: str | None) -> _Run:
 
 
 def _from_stream(log, label: str, engine: str = "EventDriven", segments=(), dt=None) -> _Run:
-    """A run from the :class:`~discsim.io.streams.StreamedEvents` of :func:`discsim.read_events` (in memory)."""
+    """A run from the :class:`~discsim.io.streams.StreamedEvents` of :func:`discsim.read_events` (in memory).
+
+    ``segments``: the run's segments; none given, those of the log's header."""
     events = log.events
     gravity = flight(log.gravity, getattr(log, "drag", 0.0), what=f"the viewer of {label!r}")
     return _Run(
         label=label,
         engine=engine,
         box=log.box,
-        segments=tuple(segments),
+        segments=tuple(segments) or tuple(getattr(log, "segments", ())),
         origin=LastRecords.at_start(log.discs, float(log.start_time), log.ids, log.resting),
         start_time=float(log.start_time),
         end_time=float(log.end_time),
@@ -181,7 +185,8 @@ def _from_stream(log, label: str, engine: str = "EventDriven", segments=(), dt=N
 def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments=(), dt=None, sensors=()) -> _Run:
     """A run from a streamed log on disk, read chunk by chunk when the page is made (never whole).
 
-    ``sensors`` (an engine's, or a checkpoint's scene): the run's sensors; none given, those of the log's header.
+    ``segments``, ``sensors`` (an engine's, or a checkpoint's scene): the run's segments and sensors; none given,
+    those of the log's header.
     """
     from discsim.io.container import stream_index
     from discsim.io.streams import iter_events
@@ -193,7 +198,7 @@ def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments
         label=label,
         engine=engine,
         box=log.box,
-        segments=tuple(segments),
+        segments=tuple(segments) or log.segments,
         origin=LastRecords.at_start(log.discs, log.start_time, log.ids, log.resting),
         start_time=log.start_time,
         end_time=log.end_time,
@@ -205,14 +210,14 @@ def _from_log_file(path: Path, label: str, engine: str = "EventDriven", segments
 
 
 def _checkpoint_scene(path: Path):
-    """``(engine name, segments, dt, sensors)`` stored in a checkpoint, without building the engine."""
+    """``(engine name, segments, dt, sensors)`` stored in a checkpoint, without building the engine (a moving
+    segment with its velocity)."""
     from discsim.io.container import read_state
-    from discsim.io.streams import sensors_from_rows
-    from discsim.model import Segment
+    from discsim.io.streams import segments_from_rows, sensors_from_rows
 
     meta, _ = read_state(path)
     scene = meta.get("scene") or {}
-    segments = [Segment(s[:2], s[2:]) for s in scene.get("segments") or []]
+    segments = segments_from_rows(scene.get("segments"), path)
     sensors = sensors_from_rows(scene.get("sensors"), path)
     dt = (meta.get("settings") or {}).get("dt")
     return str(meta.get("engine", "EventDriven")), segments, (float(dt) if dt else None), sensors
@@ -386,6 +391,8 @@ def _turning_records(history: tuple, starts: np.ndarray, times: np.ndarray) -> n
 
 
 def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict:
+    from discsim.io.streams import segment_rows
+
     starts, times, states, partners, kinds = _records(span, t0)
     discs = _discs_of(span)
     disc = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
@@ -409,7 +416,7 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
         "truth": truth,
         "n": len(discs),
         "box": {"width": float(box.width), "height": float(box.height), "periodic": bool(box.periodic)},
-        "segments": [[*map(float, s.p0), *map(float, s.p1)] for s in run.segments],
+        "segments": segment_rows(run.segments),  # as checkpoints store them: [p0, p1] or [p0, p1, velocity]
         "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in run.sensors],  # as checkpoints store them
         "enter_times": _b64(entries["time"], "<f8"),
         "enter_sensors": _b64(entries["j"], "<i4"),

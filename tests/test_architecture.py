@@ -26,7 +26,19 @@ FLOORS = {
     "model": ["scene", "laws", "events", "cells", "repair", "spatial"],
     "physics": ["physics", "kernels", "trajectory", "losses"],
     "engines": ["engines"],
-    "top": ["run", "io", "analysis", "cli", "plot", "_plot_sensors", "view", "scenarios", "__init__", "__main__"],
+    "top": [
+        "run",
+        "io",
+        "analysis",
+        "cli",
+        "plot",
+        "_plot_sensors",
+        "_plot_gif",
+        "view",
+        "scenarios",
+        "__init__",
+        "__main__",
+    ],
 }
 LEVEL = {name: level for level, names in enumerate(FLOORS.values()) for name in names}
 

@@ -47,7 +47,7 @@ def test_demo_without_gif_and_with_another_policy(tmp_path, capsys):
     assert len(list(tmp_path.glob("*.png"))) == 5 and not list(tmp_path.glob("*.gif"))
 
 
-@pytest.mark.parametrize("policy", ["separate", "bisect"])
+@pytest.mark.parametrize("policy", ["separate", pytest.param("bisect", marks=pytest.mark.slow)])
 def test_demo_lists_the_cases_under_the_laws_after_the_four(tmp_path, capsys, policy):
     assert cli.main(["demo", "--out", str(tmp_path), "--no-gif", "--policy", policy]) == 0
     text = capsys.readouterr().out

@@ -320,3 +320,40 @@ def test_the_plots_draw_each_sensor_once(tmp_path):
     plot.close(anim)
     assert not sensor_artists(plot.plot_state(ds.EventDriven(*ds.random_gas(5, 0.2)).run(until=0.1)))
     assert_not_blank(plot.save_figure(plot.plot_state(sim), tmp_path / "sensors.png"))
+
+
+def paddle_run():
+    """A disc, a paddle moving at (-1, 0) from x = 8 and a fixed floor, run to t = 4."""
+    paddle = ds.Segment((8.0, 3.0), (8.0, 7.0), velocity=(-1.0, 0.0))
+    floor = ds.Segment((1.0, 1.0), (9.0, 1.0))
+    discs = ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], radii=0.4)
+    return ds.EventDriven(discs, ds.Box(10.0, 10.0), segments=[paddle, floor]).run(until=4.0)
+
+
+def drawn_segments(ax) -> list:
+    (lines,) = [c for c in ax.collections if c.get_gid() == "segments"]
+    return [s.tolist() for s in lines.get_segments()]
+
+
+PADDLE_AT = {t: [[8.0 - t, 3.0], [8.0 - t, 7.0]] for t in (0.0, 1.5, 2.5, 4.0)}  # p0 + v t, p1 + v t
+FLOOR = [[1.0, 1.0], [9.0, 1.0]]
+
+
+def test_animate_draws_a_moving_segment_where_it_is_at_each_frame(tmp_path):
+    sim = paddle_run()
+    anim = plot.animate(sim, times=[1.5, 4.0])  # the figure shows the first frame
+    assert drawn_segments(anim._fig.axes[0]) == [PADDLE_AT[1.5], FLOOR]
+    plot.close(anim)
+    anim = plot.animate(sim, tmp_path / "paddle.gif", times=[0.0, 2.5], dpi=30)  # saving draws to the last frame
+    assert drawn_segments(anim._fig.axes[0]) == [PADDLE_AT[2.5], FLOOR]
+    plot.close(anim)
+
+
+def test_the_still_plots_draw_a_moving_segment_where_it_is_at_their_time():
+    sim = paddle_run()
+    assert drawn_segments(plot.plot_state(sim)) == [PADDLE_AT[4.0], FLOOR]
+    assert drawn_segments(plot.plot_trajectories(sim)) == [PADDLE_AT[4.0], FLOOR]  # with the final outlines
+    pit = ds.FixedStep(ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], radii=0.4), sim.box, frame_rate=10.0).run(until=4.0)
+    pit_ax, pic_ax = plot.plot_case(sim, pit).axes[:2]
+    assert drawn_segments(pic_ax) == [PADDLE_AT[4.0], FLOOR]  # at the last frame
+    assert not [c for c in pit_ax.collections if c.get_gid() == "segments"]  # PIT's run has no segments

@@ -595,3 +595,69 @@ def test_the_page_draws_the_sensors_and_lights_one_a_disc_enters(tmp_path):
     pixels = matplotlib.image.imread(shot)[..., :3]
     gold = np.array([0xB8, 0x86, 0x0B]) / 255.0
     assert (np.abs(pixels - gold).max(axis=2) < 0.03).sum() > 100
+
+
+# --- moving segments ---------------------------------------------------------------------------------------
+
+PADDLE = ((8.0, 3.0), (8.0, 7.0), (-1.0, 0.0))  # p0, p1 at time 0 and the velocity: x = 8 - t
+FLOOR = ((1.0, 1.0), (9.0, 1.0))  # a fixed segment
+SEGMENT_ROWS = [[8.0, 3.0, 8.0, 7.0, -1.0, 0.0], [1.0, 1.0, 9.0, 1.0]]  # a moving row carries its velocity
+
+
+def paddle_run(**kwargs):
+    """A disc in a 10 x 10 box, a paddle that moves at (-1, 0) and a fixed floor."""
+    p0, p1, v = PADDLE
+    segments = [ds.Segment(p0, p1, velocity=v), ds.Segment(*FLOOR)]
+    disc = ds.Discs([[2.0, 5.0]], [[1.0, 0.0]], radii=0.4)
+    return ds.EventDriven(disc, ds.Box(10.0, 10.0), segments=segments, **kwargs)
+
+
+def test_the_page_gets_each_moving_segment_s_velocity_and_a_fixed_one_as_before():
+    (run,) = page_data(ds.view(paddle_run().run(until=4.0), path=None))["runs"]
+    assert run["segments"] == SEGMENT_ROWS
+
+
+def test_moving_segments_come_back_from_a_stream_a_run_folder_and_a_checkpoint(tmp_path):
+    folder = tmp_path / "run"
+    folder.mkdir()
+    streamed = paddle_run(record=False).run(until=4.0, record_to=folder / "events.dse")
+    streamed.save(folder / "state.dsc")  # its log is the file: the viewer reads the scene from the checkpoint
+    in_memory = paddle_run().run(until=4.0)
+    in_memory.save(tmp_path / "memory.dsc")
+    assert [s.velocity.tolist() for s in ds.load(folder / "state.dsc").segments] == [[-1.0, 0.0], [0.0, 0.0]]
+    # The log's header holds them too: the log alone, on disk or read back, is drawn with its segments.
+    log = ds.read_events(folder / "events.dse")
+    assert [repr(s) for s in log.segments] == [repr(s) for s in streamed.segments]
+    assert [repr(s) for s in ds.iter_events(folder / "events.dse").segments] == [repr(s) for s in log.segments]
+    for source in (streamed, folder, folder / "state.dsc", tmp_path / "memory.dsc", folder / "events.dse", log):
+        (run,) = page_data(ds.view(source, path=None))["runs"]
+        assert run["segments"] == SEGMENT_ROWS, source
+
+
+def test_a_damaged_segment_row_in_a_log_header_is_refused_by_name(tmp_path):
+    from discsim.io.container import RecordWriter
+    from discsim.io.streams import stream_header
+
+    discs, box = ds.random_gas(5, 0.2, seed=1)
+    meta, arrays = stream_header(discs, box, 0.0, "r", 0)
+    meta["segments"] = [[1.0, 1.0, 1.0, 1.0]]  # both end points the same
+    path = tmp_path / "bad.dse"
+    with RecordWriter.create(path, ds.events.EVENT_DTYPE, meta, arrays):
+        pass
+    for read in (ds.read_events, ds.iter_events, lambda p: ds.view(p, path=None)):
+        with pytest.raises(ds.errors.CheckpointError, match=r"bad.dse.*segments\[0\].*must differ"):
+            read(path)
+
+
+def test_the_page_draws_a_moving_segment_where_it_is_at_each_time(tmp_path):
+    page = ds.view(paddle_run().run(until=4.0), tmp_path / "paddle.html")
+    times = [0.0, 1.25, 4.0]
+    script = (
+        "const out = []; for (const t of TIMES) { discsim.seek(t); out.push(discsim.segments(0)); }"
+        "document.getElementById('ds-readout').textContent = JSON.stringify(out);"
+    ).replace("TIMES", json.dumps(times))
+    drawn = drive(page.path, tmp_path, script)
+    (p0x, p0y), (p1x, p1y), (vx, vy) = PADDLE
+    for t, (paddle, floor) in zip(times, drawn, strict=True):
+        assert paddle == [p0x + vx * t, p0y + vy * t, p1x + vx * t, p1y + vy * t]  # p0 + v t, p1 + v t
+        assert floor == [*FLOOR[0], *FLOOR[1]]  # a fixed segment stays put

@@ -10,7 +10,8 @@
 // state is NaN (before its ADD record, from its REMOVE record on: add_discs / remove_discs) is not drawn.
 // Sensors (rows [code, a0, a1, a2, a3]: 1 a circle, 2 a rectangle, 3 a trip wire) are drawn under the discs:
 // regions translucent and outlined, a wire dashed with a small arrow to its inside (the left of p1 - p0); a
-// sensor lights up for 0.3 s of playing after a disc enters it (the log's ENTER records).
+// sensor lights up for 0.3 s of playing after a disc enters it (the log's ENTER records). Segments (rows [x0, y0,
+// x1, y1] at time 0, and [vx, vy] after them for a moving one) are drawn where they are at the time drawn.
 "use strict";
 (function () {
   const DATA = JSON.parse(document.getElementById("ds-data").textContent);
@@ -61,6 +62,7 @@
       enterSensors: decode(r.enter_sensors, Int32Array),
     };
     run.lit = new Uint8Array(run.sensors.length);
+    run.drawnSegments = [];
     run.x = new Float64Array(run.n);
     run.y = new Float64Array(run.n);
     run.rec = new Int32Array(run.n);
@@ -126,6 +128,30 @@
     for (let e = lo - 1; e >= 0 && t - times[e] <= span; e--) run.lit[run.enterSensors[e]] = 1;
   }
 
+  // An arrow on the canvas from (bx, by) to (ex, ey) (pixels), its head `head` pixels long, in the current colours.
+  function drawArrow(ctx, bx, by, ex, ey, head) {
+    const len = Math.hypot(ex - bx, ey - by), ux = (ex - bx) / len, uy = (ey - by) / len;
+    ctx.beginPath();
+    ctx.moveTo(bx, by);
+    ctx.lineTo(ex, ey);
+    ctx.stroke();
+    ctx.beginPath();
+    ctx.moveTo(ex, ey);
+    ctx.lineTo(ex - head * (ux + 0.5 * uy), ey - head * (uy - 0.5 * ux));
+    ctx.lineTo(ex - head * (ux - 0.5 * uy), ey - head * (uy + 0.5 * ux));
+    ctx.fill();
+  }
+
+  // Each segment's end points at time t into run.drawnSegments ([x0, y0, x1, y1]): a moving one (a row of six:
+  // p0, p1, velocity) at p0 + v t, p1 + v t (Segment.at's arithmetic); a fixed one (four) where it is.
+  function placeSegments(run, t) {
+    run.drawnSegments = run.segments.map((s) => {
+      if (s.length < 6) return s.slice(0, 4);
+      const sx = s[4] * t, sy = s[5] * t;
+      return [s[0] + sx, s[1] + sy, s[2] + sx, s[3] + sy];
+    });
+  }
+
   function drawSensors(ctx, run, X, Y, z) {
     ctx.strokeStyle = SENSOR;
     ctx.fillStyle = SENSOR;
@@ -140,18 +166,9 @@
         ctx.stroke();
         ctx.setLineDash([]);
         const len = Math.hypot(a2 - a0, a3 - a1), nx = -(a3 - a1) / len, ny = (a2 - a0) / len;
-        const bx = X((a0 + a2) / 2), by = Y((a1 + a3) / 2), ux = nx, uy = -ny;  // the canvas's y points down
-        const size = 12, ex = bx + size * ux, ey = by + size * uy, head = 5;
+        const bx = X((a0 + a2) / 2), by = Y((a1 + a3) / 2), size = 12;  // the canvas's y points down
         ctx.lineWidth = 1.5;
-        ctx.beginPath();
-        ctx.moveTo(bx, by);
-        ctx.lineTo(ex, ey);
-        ctx.stroke();
-        ctx.beginPath();
-        ctx.moveTo(ex, ey);
-        ctx.lineTo(ex - head * (ux + 0.5 * uy), ey - head * (uy - 0.5 * ux));
-        ctx.lineTo(ex - head * (ux - 0.5 * uy), ey - head * (uy + 0.5 * ux));
-        ctx.fill();
+        drawArrow(ctx, bx, by, bx + size * nx, by - size * ny, 5);
         continue;
       }
       ctx.beginPath();
@@ -332,16 +349,7 @@
         const ex = X(x + vx * arrowTime), ey = Y(y + vy * arrowTime);
         const bx = X(x), by = Y(y), len = Math.hypot(ex - bx, ey - by);
         if (len < 1) continue;
-        const head = Math.min(6, 0.4 * len), ux = (ex - bx) / len, uy = (ey - by) / len;
-        ctx.beginPath();
-        ctx.moveTo(bx, by);
-        ctx.lineTo(ex, ey);
-        ctx.stroke();
-        ctx.beginPath();
-        ctx.moveTo(ex, ey);
-        ctx.lineTo(ex - head * (ux + 0.5 * uy), ey - head * (uy - 0.5 * ux));
-        ctx.lineTo(ex - head * (ux - 0.5 * uy), ey - head * (uy + 0.5 * ux));
-        ctx.fill();
+        drawArrow(ctx, bx, by, ex, ey, Math.min(6, 0.4 * len));
       }
     }
     if (state.numbers && run.n <= 50) {
@@ -362,7 +370,7 @@
     ctx.strokeRect(X(0), Y(box.height), box.width * z, box.height * z);
     ctx.setLineDash([]);
     ctx.lineWidth = 2;
-    for (const s of run.segments) {
+    for (const s of run.drawnSegments) {
       ctx.beginPath();
       ctx.moveTo(X(s[0]), Y(s[1]));
       ctx.lineTo(X(s[2]), Y(s[3]));
@@ -428,6 +436,7 @@
     for (const p of panels) {
       evaluate(p.run, state.t);
       light(p.run, state.t);
+      placeSegments(p.run, state.t);
       p.run.drawnTime = state.t;
       draw(p, state.t);
     }
@@ -582,6 +591,11 @@
     return run.sensors.map((row, k) => ({ shape: SENSOR_SHAPES[row[0]], params: row.slice(1), lit: !!run.lit[k] }));
   }
 
+  // The segments last drawn on a panel: [[x0, y0, x1, y1], ...] (a moving one where it was at the time drawn).
+  function segments(panel = 0) {
+    return panels[panel].run.drawnSegments.map((s) => s.slice());
+  }
+
   // Writes {time, positions: [panel][disc][x, y]} into <pre id="ds-readout"> for tools that read the DOM.
   function readout() {
     const out = { time: state.t, drawn: panels.map((p) => p.run.drawnTime), positions: panels.map((_, k) => positions(k)) };
@@ -604,7 +618,7 @@
   window.addEventListener("resize", () => { layout(); render(); });
 
   window.discsim = {
-    seek, time: () => state.t, positions, angles, sensors, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
+    seek, time: () => state.t, positions, angles, sensors, segments, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
     setColour, setZoom, setArrows, zoom: () => state.zoom, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
     labels: runs.map((r) => r.label), eventTimes: () => eventTimes.slice(),
   };

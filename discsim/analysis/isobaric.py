@@ -22,7 +22,7 @@ import numpy as np
 
 from discsim.analysis.equilibration import detect_equilibration, statistical_inefficiency
 from discsim.errors import InvalidArgumentError, TimeError
-from discsim.events import ADD, REMOVE, SET, WALL
+from discsim.events import ADD, EVENT_DTYPE, REMOVE, SET, WALL
 from discsim.physics.sources.piston import at
 
 __all__ = ["IsobaricAverages", "isobaric"]
@@ -90,12 +90,13 @@ class IsobaricAverages:
 
 
 def isobaric(sim, since: float | str | None = None) -> IsobaricAverages:
-    """The averages of ``sim``, an :class:`~discsim.EventDriven` run with a piston that kept its log in memory, from
-    ``since`` on (``"auto"``: from the start of production that automated equilibration detection finds in the
+    """The averages of ``sim``, an :class:`~discsim.EventDriven` run with a piston that kept its log (in memory, or
+    streamed with ``run(record_to=...)``: read back chunk by chunk, only the piston's impacts and the edits kept),
+    from ``since`` on (``"auto"``: from the start of production that automated equilibration detection finds in the
     series of ``Z``; None: from the piston's first impact). :func:`discsim.thermo` calls it for a piston run.
 
     Raises:
-        InvalidArgumentError: if ``sim`` has no piston or kept no log, or the piston was never hit.
+        InvalidArgumentError: if ``sim`` has no piston or recorded no log, or the piston was never hit.
         TimeError: if ``since`` lies outside the span the log can follow: before the piston's first impact, or
             before a change of the pressure (``set_piston``) or of the discs (``set_velocities``, ``add_discs`` ...).
     """
@@ -103,10 +104,21 @@ def isobaric(sim, since: float | str | None = None) -> IsobaricAverages:
     if piston is None:
         msg = "isobaric() needs a run with a piston (EventDriven(..., piston=ds.Piston(...)))"
         raise InvalidArgumentError(msg)
-    if not getattr(sim, "record", False):
-        msg = "isobaric() reads the piston's impacts from the log: run with record=True"
+    laws = getattr(sim, "laws", None)
+    if laws is not None and laws.falls:
+        msg = (
+            f"isobaric() averages a gas that keeps its kinetic energy between the piston's impacts; under gravity "
+            f"{laws.gravity} it does not (sample it with ds.Sampler(dt) and sim.piston instead)"
+        )
         raise InvalidArgumentError(msg)
-    events = sim.events
+    from discsim.analysis.frames import _log_source
+
+    chunks = _log_source(sim, "isobaric()")[0]  # (refuses a run that recorded nothing, saying how to record)
+    kept = []
+    for records in chunks():
+        keep = ((records["kind"] == WALL) & np.isfinite(records["yj"])) | np.isin(records["kind"], (SET, ADD, REMOVE))
+        kept.append(records[keep])
+    events = np.concatenate(kept) if kept else np.zeros(0, dtype=EVENT_DTYPE)
     hits = events[(events["kind"] == WALL) & np.isfinite(events["yj"])]
     if len(hits) < 2:
         msg = f"the piston was hit {len(hits)} time(s): run longer"

@@ -15,7 +15,7 @@ import numpy as np
 from discsim.errors import CheckpointError, DiscsimError, InvalidArgumentError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import iter_stream, read_stream, stream_index
-from discsim.model import Box, Discs
+from discsim.model import Box, Discs, Segment
 from discsim.sensors import CIRCLE, LINE, RECTANGLE, Sensor
 from discsim.trajectory import LastRecords, check_times, flight, positions_from_log, replay
 
@@ -27,6 +27,8 @@ __all__ = [
     "StreamedEvents",
     "iter_events",
     "read_events",
+    "segment_rows",
+    "segments_from_rows",
     "sensors_from_rows",
     "stream_header",
     "trajectory_from_events",
@@ -49,6 +51,7 @@ def stream_header(
     resting=None,
     drag: float = 0.0,
     sensors=(),
+    segments=(),
 ) -> tuple[dict, dict]:
     """Header ``(meta, arrays)`` of a streamed event log: the discs at ``start_time`` and the box.
 
@@ -66,6 +69,8 @@ def stream_header(
             then, naming it.
         sensors: the run's :class:`~discsim.sensors.Sensor` s, stored when any as rows ``[code, a0, a1, a2, a3]``
             (as checkpoints store them), so that a viewer of the log alone draws them.
+        segments: the run's :class:`~discsim.model.Segment` s, stored when any as rows (:func:`segment_rows`),
+            so that a viewer of the log alone draws them where they are (a moving one with its velocity).
     """
     meta = {
         "kind": STREAM_KIND,
@@ -81,6 +86,8 @@ def stream_header(
         meta["drag"] = float(drag)
     if len(sensors):
         meta["sensors"] = [[sensor.code, *sensor.params.tolist()] for sensor in sensors]
+    if len(segments):
+        meta["segments"] = segment_rows(segments)
     arrays = {
         "positions": discs.positions,
         "velocities": discs.velocities,
@@ -112,6 +119,8 @@ class StreamedEvents:
         resting: ``(N,)`` bool, the ``discs`` at rest at ``start_time`` (under gravity), or None: none.
         drag: the run's drag ``gamma`` (0: none; :meth:`trajectory` follows its exponential flights).
         sensors: the run's :class:`~discsim.sensors.Sensor` s, if its header holds them (else ``()``).
+        segments: the run's :class:`~discsim.model.Segment` s (with their velocities), if its header holds them
+            (else ``()``).
     """
 
     events: np.ndarray
@@ -125,6 +134,7 @@ class StreamedEvents:
     resting: np.ndarray | None = None
     drag: float = 0.0
     sensors: tuple = ()
+    segments: tuple = ()
 
     def trajectory(self, times, *, unwrapped: bool = False) -> np.ndarray:
         """Exact positions ``(T, M, 2)`` at ``times`` ``(T,)`` in ``[start_time, end_time]``, one column per disc id.
@@ -203,6 +213,7 @@ def read_events(path, *, partial: bool = False) -> StreamedEvents:
         _resting(path, stream.arrays, len(discs)),
         float(stream.meta.get("drag", 0.0)),
         sensors_from_rows(stream.meta.get("sensors"), path),
+        segments_from_rows(stream.meta.get("segments"), path),
     )
 
 
@@ -235,6 +246,41 @@ def sensors_from_rows(rows, where) -> tuple[Sensor, ...]:
             raise CheckpointError(msg) from exc
         sensors.append(sensor)
     return tuple(sensors)
+
+
+def segment_rows(segments) -> list[list[float]]:
+    """Rows ``[p0x, p0y, p1x, p1y]`` of fixed :class:`~discsim.model.Segment` s and ``[p0x, p0y, p1x, p1y, vx, vy]``
+    of moving ones (end points at time 0, velocity in length / time), as checkpoints and event-log headers store them.
+
+    Example:
+        >>> segment_rows([Segment((0, 0), (1, 0)), Segment((0, 1), (1, 1), velocity=(0, -0.5))])
+        [[0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 1.0, 1.0, 0.0, -0.5]]
+    """
+    return [[*s.p0.tolist(), *s.p1.tolist(), *(s.velocity.tolist() if s.moving else [])] for s in segments]
+
+
+def segments_from_rows(rows, where) -> tuple[Segment, ...]:
+    """The :class:`~discsim.model.Segment` s stored as :func:`segment_rows` (None: none), checked.
+
+    Args:
+        rows: the rows of an event log's header or a checkpoint's scene (4 numbers a fixed segment, 6 a moving one).
+        where: the file they come from, named in the error.
+
+    Raises:
+        CheckpointError: naming the file and the first row that is not a valid segment.
+    """
+    segments = []
+    for k, row in enumerate(rows or ()):
+        try:
+            values = [float(x) for x in row]
+            if len(values) not in (4, 6):
+                msg = f"{len(values)} numbers, expected 4 (p0, p1) or 6 (p0, p1, velocity)"
+                raise ValueError(msg)
+            segments.append(Segment(values[:2], values[2:4], values[4:6] if len(values) == 6 else (0.0, 0.0)))
+        except (TypeError, ValueError, DiscsimError) as exc:
+            msg = f"{where}: segments[{k}] = {row!r} is not a segment ({exc})"
+            raise CheckpointError(msg) from exc
+    return tuple(segments)
 
 
 def _resting(path, arrays, n: int) -> np.ndarray | None:
@@ -298,6 +344,7 @@ class EventChunks:
         gravity: the run's ``(gx, gy)`` from the header (None: free flight), which the unwrapped ``before``
             positions follow between records. resting: ``(N,)`` bool, the ``discs`` at rest where the log starts
             (None: none). sensors: the run's :class:`~discsim.sensors.Sensor` s, if the header holds them.
+        segments: the run's :class:`~discsim.model.Segment` s (with their velocities), if the header holds them.
     """
 
     path: Path
@@ -315,6 +362,7 @@ class EventChunks:
     gravity: tuple | None = None
     resting: np.ndarray | None = None
     sensors: tuple = ()
+    segments: tuple = ()
 
     def __iter__(self) -> Iterator[EventChunk]:
         carry = LastRecords.at_start(self.discs, self.start_time, self.ids, self.resting)
@@ -417,6 +465,7 @@ def iter_events(
         None if gravity is None else (float(gravity[0]), float(gravity[1])),
         _resting(path, arrays, len(discs)),
         sensors_from_rows(meta.get("sensors"), path),
+        segments_from_rows(meta.get("segments"), path),
     )
 
 

@@ -202,7 +202,10 @@ class EventStream(Observer):
         resting = None if from_start else getattr(engine, "resting", None)  # a log from mid-run: who rests then
         drag = laws.drag if laws is not None else 0.0
         sensors = getattr(engine, "sensors", ())
-        meta, arrays = stream_header(discs, engine.box, start, run_id, base, ids, gravity, resting, drag, sensors)
+        segments = getattr(engine, "segments", ())
+        meta, arrays = stream_header(
+            discs, engine.box, start, run_id, base, ids, gravity, resting, drag, sensors, segments
+        )
         self._writer = RecordWriter.create(self.path, EVENT_DTYPE, meta, arrays)
         self._created = True
         context.stream = {

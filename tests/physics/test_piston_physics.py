@@ -42,32 +42,39 @@ def test_the_equation_of_state_at_fixed_pressure_is_the_one_at_fixed_volume():
     assert averages.z_err < 0.03 and z_v_err < 0.02
 
 
-def compress(discs, box, steps, duration, mass=10.0):
-    """Quadruple the pressure on a dilute gas in ``steps`` equal ratios over ``duration``; the averages before and
-    after (each over 3,000 time units, the first 100 skipped)."""
+def compress(discs, box, steps, duration, settle, mass=10.0):
+    """Quadruple the pressure on a dilute gas in ``steps`` equal ratios over ``duration``: the averages before and
+    after (each over ``settle`` time units, the first tenth skipped), and the energy ``K + M U^2 / 2 + P_f A`` the
+    gas and piston hold from the moment the pressure first changes (conserved from then on for one step)."""
     kinetic = 0.5 * float(np.sum(discs.masses * np.sum(discs.velocities**2, axis=1)))
     p0 = ds.henderson_z(0.005) * kinetic / box.area
     piston = ds.Piston(mass=mass, pressure=p0, height=box.height)
-    sim = ds.EventDriven(discs, ds.Box(box.width, 3 * box.height), piston=piston).run(until=3000.0)
-    before = ds.thermo(sim, since=100.0)
-    for p in p0 * 4.0 ** (np.arange(1, steps + 1) / steps):
+    sim = ds.EventDriven(discs, ds.Box(box.width, 3 * box.height), piston=piston).run(until=settle)
+    before = ds.thermo(sim, since=settle / 10)
+    pressures = p0 * 4.0 ** (np.arange(1, steps + 1) / steps)
+    now = sim.piston
+    energy = sim.kinetic_energy() + 0.5 * mass * now.velocity**2 + pressures[-1] * box.width * now.height
+    for p in pressures:
         sim.set_piston(pressure=p)
         sim.run(until=sim.time + duration / steps)
     end = sim.time
-    sim.run(until=end + 3000.0)
-    return before, ds.thermo(sim, since=end + 100.0)
+    sim.run(until=end + settle)
+    return before, ds.thermo(sim, since=end + settle / 10), energy
 
 
 def test_a_slow_compression_follows_the_adiabat_and_a_sudden_one_heats_more():
     discs, box = ds.random_gas(200, 0.005, seed=7, periodic=False)
-    before, slow = compress(discs, box, 400, 20000.0)
+    before, slow, _ = compress(discs, box, 400, 20000.0, 10000.0)
     # The adiabat of a 2D ideal gas: P A^2 = const, so at 4 P the area halves and kT doubles.
-    assert slow.temperature / before.temperature == pytest.approx(2.0, rel=0.05)
-    assert slow.area / before.area == pytest.approx(0.5, rel=0.05)
-    assert slow.pressure * slow.area**2 / (before.pressure * before.area**2) == pytest.approx(1.0, rel=0.08)
-    # At once: the first law with the constant external pressure P_f, N kT_f - N kT_i = P_f (A_i - A_f) and
-    # P_f A_f = N kT_f, gives kT_f = kT_i (1 + P_f / P_i) / 2 = 2.5 kT_i and A_f = 0.625 A_i: more heat, less squeeze.
-    before, sudden = compress(discs, box, 1, 1.0)
-    assert sudden.temperature / before.temperature == pytest.approx(2.5, rel=0.05)
-    assert sudden.area / before.area == pytest.approx(0.625, rel=0.05)
+    assert slow.temperature / before.temperature == pytest.approx(2.0, rel=0.03)
+    assert slow.area / before.area == pytest.approx(0.5, rel=0.04)
+    assert slow.pressure * slow.area**2 / (before.pressure * before.area**2) == pytest.approx(1.0, rel=0.06)
+    # At once: the final pressure P_f does the work P_f (A_i - A_f) on the gas, so (first law, ideal gas: P_f A_f =
+    # N kT_f, K = N kT, the piston's kinetic energy kT / 2) N kT_f (2 + 1 / (2N)) = K_i + M U_i^2 / 2 + P_f A_i, from
+    # the moment of the jump: on average over where the piston was then, kT_f = 2.5 kT_i and A_f = 0.625 A_i.
+    before, sudden, energy = compress(discs, box, 1, 1.0, 20000.0)
+    n = len(discs)
+    assert sudden.temperature == pytest.approx(energy / (2 * n + 0.5), rel=0.02)
+    assert sudden.temperature / before.temperature == pytest.approx(2.5, rel=0.08)
+    assert sudden.area / before.area == pytest.approx(0.625, rel=0.08)
     assert sudden.temperature > 1.15 * slow.temperature

@@ -100,7 +100,7 @@ class EventDriven(PistonRun, Turning, RunStops, Engine):
             ``run(events=...)``. They run on the compiled loop, as laws other than the defaults do.
         piston: a :class:`~discsim.piston.Piston` that makes the box's top wall a piston of finite mass under a
             constant pressure (a run at constant pressure: :attr:`piston`, :meth:`set_piston`), or a kinematic lid;
-            None: none. Compiled loop, default laws only (``docs/users/physics.md``).
+            None: none. Elastic, smooth discs without drag; gravity down along y at most (``docs/users/physics.md``).
 
     Raises:
         OutsideBoxError, OverlapError: if the discs do not fit in the box.

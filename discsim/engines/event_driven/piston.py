@@ -71,7 +71,7 @@ class PistonRun:
         velocity = now_velocity if velocity is None else velocity
         Piston(given.mass, pressure, height, velocity)  # refuses what a new piston would (names the value)
         discs = self.snapshot()
-        check_room(given, self.box, discs, height, float(velocity), float(pressure))
+        check_room(given, self.box, discs, height, float(velocity), float(pressure), -self.laws.gravity[1])
         self._piston_asked = (float(pressure), float(velocity))
         try:
             self._restructure(np.arange(len(discs)), None, self.scene.but(discs), self._backend.last_event())
@@ -95,14 +95,18 @@ class PistonRun:
         asked_pressure, asked_velocity = self._piston_asked
         pressure = pressure if asked_pressure is None else asked_pressure
         velocity = velocity if asked_velocity is None else asked_velocity
-        check_room(self.scene.piston, self.box, discs, height, velocity, pressure)
+        check_room(self.scene.piston, self.box, discs, height, velocity, pressure, -self.laws.gravity[1])
         return np.array([height, velocity, 0.0, float(hits), pressure])
 
 
-def check_room(piston: Piston, box: Box, discs: Discs, height: float, velocity: float, pressure: float) -> None:
+def check_room(
+    piston: Piston, box: Box, discs: Discs, height: float, velocity: float, pressure: float, fall: float = 0.0
+) -> None:
     """Refuse ``discs`` with a top above ``piston`` at ``height``, or a gas that could lift it (at ``velocity``,
     under ``pressure``) above the box, naming the disc or the height it could reach: energy bounds its height by
-    ``H + (K + M U^2 / 2) / F`` (``K`` the discs' kinetic energy, ``F`` the pressure times the box's width)."""
+    ``H + (K + V + M U^2 / 2) / F`` (``K`` the discs' kinetic energy, ``V = g sum m (y - r)`` their potential energy
+    above the floor under gravity ``g = fall`` down along y, ``F`` the pressure times the box's width plus the
+    piston's weight ``M g``)."""
     tops = discs.positions[:, 1] + discs.radii
     if len(tops) and float(tops.max()) > height:
         k = int(np.argmax(tops))
@@ -111,7 +115,8 @@ def check_room(piston: Piston, box: Box, discs: Discs, height: float, velocity: 
     if piston.kinematic:
         return
     kinetic = 0.5 * float(np.sum(discs.masses * np.sum(discs.velocities**2, axis=1)))
-    highest = height + (kinetic + 0.5 * piston.mass * velocity**2) / (pressure * box.width)
+    kinetic += fall * float(np.sum(discs.masses * (discs.positions[:, 1] - discs.radii)))
+    highest = height + (kinetic + 0.5 * piston.mass * velocity**2) / (pressure * box.width + piston.mass * fall)
     if highest > box.height:
         msg = (
             f"the piston (mass {piston.mass!r}, pressure {pressure!r}, velocity {velocity!r}) could rise to "

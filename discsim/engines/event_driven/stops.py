@@ -47,11 +47,17 @@ def check_parts(scene: Scene, laws) -> None:
 
 
 def check_piston(scene: Scene, laws) -> None:
-    """Refuse, by name, a piston with what it does not take yet (laws other than the defaults, obstacles, moving
-    segments), a piston of finite mass over no disc, and one the gas could lift out of the box (:func:`check_room`)."""
+    """Refuse, by name, a piston with what it does not take yet (restitution, roughness, drag, gravity other than
+    down along y, obstacles, moving segments), a piston of finite mass over no disc, and one the gas could lift out
+    of the box (:func:`check_room`)."""
     piston, discs = scene.piston, scene.discs
-    if not laws.default:
-        msg = f"a piston runs under the default laws (elastic, smooth, no gravity or drag) only, not {laws!r}"
+    elastic = laws.restitution == 1.0 and not laws._pairs
+    if not elastic or laws.rough or laws.drag or laws.gravity[0] != 0.0 or laws.gravity[1] > 0.0:
+        msg = (
+            "a piston runs with elastic, smooth discs without drag, under no gravity or gravity down along y, not "
+            f"restitution={laws.restitution!r}, roughness={laws.roughness!r}, drag={laws.drag!r}, "
+            f"gravity={laws.gravity!r}"
+        )
         raise InvalidArgumentError(msg)
     if scene.moving:
         k = next(k for k, segment in enumerate(scene.segments) if segment.moving)
@@ -64,7 +70,7 @@ def check_piston(scene: Scene, laws) -> None:
     if not piston.kinematic and not len(discs):
         msg = "a piston of finite mass needs discs under it (it would fall for ever)"
         raise InvalidArgumentError(msg)
-    check_room(piston, scene.box, discs, scene.piston_height, piston.velocity, piston.pressure)
+    check_room(piston, scene.box, discs, scene.piston_height, piston.velocity, piston.pressure, -laws.gravity[1])
 
 
 class RunStops:

@@ -149,6 +149,7 @@ def test_all_queues_give_the_same_events():
         assert a.events.tobytes() == b.events.tobytes(), queue
 
 
+@pytest.mark.slow_on_python
 def test_calendar_queue_matches_the_sorted_queue_over_many_laps_and_epoch_moves():
     """Long enough for the calendar to wrap its ring many times and re-bin, with the epoch moved often."""
     discs, box = ds.random_gas(1500, 0.3, seed=14)

@@ -31,6 +31,7 @@ def test_a_jammed_start_is_refused_by_name_and_leaves_a_consistent_engine(name):
     sim.state().check(len(discs), len(sim.grid))
 
 
+@pytest.mark.slow_on_python  # (2 s a case interpreted; the numba cases stay quick)
 @pytest.mark.parametrize("name", sorted(JAMS))
 def test_a_jam_ends_an_event_count_run_step_and_chunked_runs(name, tmp_path):
     discs, box, _ = JAMS[name]()
@@ -121,6 +122,7 @@ def test_an_unbounded_cascade_creeping_towards_an_instant_is_a_jam(chunks):
     np.testing.assert_allclose(momentum, before[1], rtol=1e-12)
 
 
+@pytest.mark.slow_on_python
 def test_a_finite_cascade_of_a_large_mass_ratio_is_not_a_jam():
     """Mass ratio 10^10: pi / 2 10^5 bounces squeeze the light disc, then the heavy one turns back (Galperin's
     billiard); those bounces come slower than ``jam_time``, and the run ends."""

@@ -254,3 +254,36 @@ def test_a_rough_disc_bounces_off_a_moving_segment_as_off_a_fixed_one_from_its_f
     assert a.time == pytest.approx(b.time, rel=1e-13)
     assert moving.velocities[0] == pytest.approx(still.velocities[0] + u, rel=1e-12)
     assert moving.spins[0] == pytest.approx(still.spins[0], rel=1e-12) and moving.spins[0] != 2.0
+
+
+@pytest.mark.slow
+def test_a_box_of_four_moving_segments_closes_slowly_on_a_gas_and_heats_it_along_the_adiabat():
+    # Four walls closing at a speed far below the gas's: a slow compression, dK = -P dA with P = Z K / A, so
+    # ln(K1 / K0) = integral of Z(eta) / eta from eta0 to eta1: halving the side (eta x4) multiplies K by 4 for an
+    # ideal gas (P A^2 = const), by more for hard discs (Henderson's Z). The walls overlap at the corners.
+    discs, box = ds.random_gas(60, 0.02, seed=3, periodic=False)
+    side, u = box.width, 0.002
+    walls = [
+        ds.Segment((0.0, 0.0), (0.0, side), velocity=(u, 0.0)),
+        ds.Segment((side, 0.0), (side, side), velocity=(-u, 0.0)),
+        ds.Segment((0.0, 0.0), (side, 0.0), velocity=(0.0, u)),
+        ds.Segment((0.0, side), (side, side), velocity=(0.0, -u)),
+    ]
+    margin = float(discs.radii.max()) * 1.01
+    inside = np.all((discs.positions > margin) & (discs.positions < side - margin), axis=1)
+    discs = ds.Discs(discs.positions[inside], discs.velocities[inside], radii=discs.radii[inside])
+    sim = ds.EventDriven(discs, box, segments=walls)
+    k0 = sim.kinetic_energy()
+    t_half = side / 4 / u  # each wall has moved a quarter of the side: the square's side is halved
+    sim.run(until=t_half)
+    # The ideal part over the area the centres can reach, (side - 2r)^2, the hard discs' part from Henderson's Z.
+    r = float(discs.radii[0])
+    ideal = ((side - 2 * r) / (side / 2 - 2 * r)) ** 2
+    eta0 = float(np.sum(np.pi * discs.radii**2)) / side**2
+    eta = np.linspace(eta0, 4.0 * eta0, 2001)
+    f = (ds.henderson_z(eta) - 1.0) / eta
+    expected = ideal * math.exp(float(np.sum((f[1:] + f[:-1]) * np.diff(eta)) / 2.0))
+    assert expected > 4.5  # (the walls' reach and the discs' own area both show)
+    assert sim.kinetic_energy() / k0 == pytest.approx(expected, rel=0.02)
+    lo, hi = u * t_half, side - u * t_half
+    assert ((sim.positions > lo) & (sim.positions < hi)).all()

@@ -26,6 +26,7 @@ def _lockstep_times(sim, steps):
         just_collided = {frozenset((event.i, event.j))} if event.kind == "collision" else set()
 
 
+@pytest.mark.slow_on_python  # (4 s interpreted; the numba case stays quick)
 @pytest.mark.parametrize("periodic", [False, True])
 @pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)])
 def test_equal_discs_follow_the_oracle(periodic, seed):  # seed 0 quick; 1 and 2 (3 s each) repeat it: slow

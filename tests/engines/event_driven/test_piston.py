@@ -145,8 +145,10 @@ def test_bad_pistons_are_refused_by_name_before_anything_runs():
         ds.EventDriven(disc, BOX, piston=ds.Piston(1.0, 1.0, height=1.2))
     with pytest.raises(InvalidArgumentError, match="above the box"):
         ds.EventDriven(ball(5.0, 1.0, 0.0, 5.0), BOX, piston=ds.Piston(1.0, 0.01, height=5.0))
-    with pytest.raises(InvalidArgumentError, match="default laws"):
+    with pytest.raises(InvalidArgumentError, match="restitution=0.5"):
         ds.EventDriven(disc, BOX, piston=ds.Piston(1.0, 1.0), restitution=0.5)
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.EventDriven(disc, BOX, piston=ds.Piston(1.0, 1.0), gravity=(0.5, -1.0))
     with pytest.raises(InvalidArgumentError, match="obstacle"):
         ds.EventDriven(ball(5.0, 1.0, m=math.inf), BOX, piston=ds.Piston(1.0, 1.0))
     sim = ds.EventDriven(ball(5.0, 1.0, 0.0, 1.0), BOX, piston=ds.Piston(1.0, 1.0, height=5.0))
@@ -210,3 +212,67 @@ def energy_of(discs, mass, pressure, width, height, velocity):
     """The energy above the floor's potential: the discs' kinetic energy, the piston's, and F H."""
     kinetic = 0.5 * float(np.sum(discs.masses * np.sum(discs.velocities**2, axis=1)))
     return kinetic + 0.5 * mass * velocity**2 + pressure * width * height
+
+
+def test_thermo_of_a_piston_run_reads_a_streamed_log_as_the_one_in_memory(tmp_path):
+    discs, _ = ds.random_gas(20, 0.3, seed=8, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 1.5, 100.0)
+    piston = ds.Piston(mass=5.0, pressure=0.3, height=float((discs.positions[:, 1] + discs.radii).max()) + 0.5)
+    kept = ds.EventDriven(discs, box, piston=piston).run(until=30.0)
+    streamed = ds.EventDriven(discs, box, piston=piston, record=False).run(until=30.0, record_to=tmp_path / "run")
+    a, b = ds.thermo(kept, since=3.0), ds.thermo(streamed, since=3.0)
+    assert (a.area, a.energy, a.z, a.hits) == (b.area, b.energy, b.z, b.hits)
+    with pytest.raises(InvalidArgumentError, match="record"):
+        ds.thermo(ds.EventDriven(discs, box, piston=piston, record=False).run(until=5.0))
+
+
+def test_a_heavy_piston_over_one_disc_oscillates_at_the_adiabatic_frequency():
+    # One disc (m = 1) bouncing at v between the floor and a piston M = 100 under F = 1: it pushes with m v^2 / L on
+    # average (L = H - 2r, the centre's run), so the piston sits where m v^2 = F L, here L = 4 at v = 2. Slow
+    # against the bounces, the disc is a 1D gas (gamma = 3: v L constant), F L^3 constant under slow moves, so the
+    # piston oscillates at omega^2 = 3 F / (M L): a period of 2 pi sqrt(M L / 3 F) = 72.55.
+    r, length, force, mass = 0.5, 4.0, 1.0, 100.0
+    piston = ds.Piston(mass=mass, pressure=force / 10.0, height=length + 2 * r, velocity=0.02)
+    sim = ds.EventDriven(ball(5.0, r, 0.0, 2.0, r=r), ds.Box(10.0, 20.0), piston=piston)
+    times = np.arange(0.0, 800.0, 0.25)
+    heights = []
+    for t in times:
+        sim.run(until=t)
+        heights.append(sim.piston.height)
+    h = np.asarray(heights) - np.mean(heights)
+    ups = times[1:][(h[:-1] < 0) & (h[1:] >= 0)]  # the piston's upward passes through its mean height
+    period = float(np.median(np.diff(ups)))
+    assert period == pytest.approx(2 * math.pi * math.sqrt(mass * length / (3 * force)), rel=0.02)
+
+
+def test_under_gravity_a_piston_with_its_weight_falls_onto_a_disc_at_rest_and_wakes_it():
+    # g = 1 down; M = 2 under P w = 2: it falls at 2 / 2 + 1 = 2 from 5.5 onto the disc resting on the floor (top at
+    # 1): sqrt(2 * 4.5 / 2); at -2 t it hits m = 1 at rest, which leaves at 2 M u / (m + M), the piston at u / 3.
+    sim = ds.EventDriven(ball(5.0, 0.5), BOX, piston=ds.Piston(mass=2.0, pressure=0.2, height=5.5), gravity=(0, -1))
+    sim.run(until=0.5)
+    assert sim.resting[0]
+    event = sim.step()
+    t = math.sqrt(4.5)
+    assert (event.kind, event.time) == ("wall", pytest.approx(t, rel=1e-13))
+    assert sim.velocities[0] == pytest.approx([0.0, 4.0 / 3.0 * -2.0 * t], rel=1e-13)
+    assert sim.piston.velocity == pytest.approx(-2.0 * t / 3.0, rel=1e-13) and not sim.resting[0]
+
+
+def test_under_gravity_a_gas_under_a_piston_keeps_its_energy_with_both_weights():
+    discs, _ = ds.random_gas(30, 0.2, seed=9, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 1.5, 150.0)
+    top = float((discs.positions[:, 1] + discs.radii).max()) + 0.5
+    g, piston = 0.05, ds.Piston(mass=6.0, pressure=0.2, height=top)
+    sim = ds.EventDriven(discs, box, piston=piston, gravity=(0.0, -g))
+
+    def total():
+        p = sim.piston
+        weights = g * float(np.sum(sim.discs.masses * sim.positions[:, 1]))
+        return sim.kinetic_energy() + weights + 0.5 * p.mass * p.velocity**2 + (0.2 * box.width + 6.0 * g) * p.height
+
+    e0 = total()
+    sim.run(until=40.0)
+    assert total() == pytest.approx(e0, rel=1e-11) and sim.piston.hits > 10
+    sim._check()
+    with pytest.raises(InvalidArgumentError, match="gravity"):
+        ds.thermo(sim)

@@ -257,7 +257,7 @@ class NumbaBackend(CompiledReads):
         seg[moving, 2:4] = seg[moving, 10:12] + seg[moving, 6:8] * state.epoch
         self._tlast = state.last_collision[order].astype(np.float64)
         if self.scene.piston is not None:  # its numbers, last in edges
-            _moving().put(self._edges, self.scene.piston.mass, state.piston, self.box.width)
+            _moving().put(self._edges, self.scene.piston.mass, state.piston, self.box.width, self.laws.gravity[1])
         self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
         self._rot = np.column_stack(

@@ -237,7 +237,7 @@ def predict(
                 best, kind, other = ts, SEGMENT, k
     stamp = 0
     if LAWS and edges.shape[0] > nx + ny + 2 + LAW_SLOTS:  # the piston above (its numbers last): when i meets it
-        ts = moving.time(yi, vyi, ri, t, edges)
+        ts = moving.time(yi, vyi, ayi, ri, t, edges)
         if ts < best:
             best, kind, other, stamp = ts, PISTON, -1, int(edges[edges.shape[0] - moving.SLOTS + moving.P_HITS])
     if best < 0.0:
@@ -596,7 +596,10 @@ def run_events(
             if kind == PISTON and qs[i] != int(edges[edges.shape[0] - moving.SLOTS + moving.P_HITS]):
                 n_stale += 1
             elif kind == PISTON:
-                moving.hit(i, t, epoch, recording, logged, rec, edges, order, ev_t, ev_kind, ev_i, ev_j, ev_f)
+                axi, ayi = accel(i, gravity, gx, gy, rec, rest)
+                moving.hit(i, t, epoch, axi, ayi, recording, logged, rec, edges, order, ev_t, ev_kind, ev_i, ev_j, ev_f)
+                if gravity and rest[i] != 0:  # it hit a disc at rest: it flies, and what it held up falls
+                    rest[i], woke = 0, i
                 count[i] += 1
                 n_wall, done, logged = n_wall + 1, done + 1, logged + (1 if recording else 0)
                 last_time, last_kind, last_i, last_j = t + epoch, WALL, i, -1

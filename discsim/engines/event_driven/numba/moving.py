@@ -52,21 +52,22 @@ def now(t, edges):
 
 
 @jit
-def time(y, vy, r, t, edges):
-    """Time from ``t`` until a disc at height ``y`` moving at ``vy`` (radius ``r``, flying freely) meets the
-    piston's path as it is now (``inf``: never)."""
+def time(y, vy, ay, r, t, edges):
+    """Time from ``t`` until a disc at height ``y`` moving at ``vy`` with the acceleration ``ay`` (gravity, or 0;
+    radius ``r``) meets the piston's path as it is now (``inf``: never): the gap falls at the piston's acceleration
+    plus the disc's."""
     h, u = now(t, edges)
-    return piston_contact(y, vy, r, h, u, edges[edges.shape[0] - SLOTS + P_ACCEL])
+    return piston_contact(y, vy, r, h, u, edges[edges.shape[0] - SLOTS + P_ACCEL] + ay)
 
 
 @jit
-def hit(i, t, epoch, recording, logged, rec, edges, order, ev_t, ev_kind, ev_i, ev_j, ev_f):
-    """Disc ``i`` meets the piston at ``t``: both bounce (momentum exchanged along y), the piston's path starts
-    afresh from there and its impacts count one more; the disc's record holds its new flight. Logged (when
-    ``recording``, in row ``logged``) as a ``WALL`` record whose ``yj`` and ``vyj`` are the piston's height and
-    velocity after."""
+def hit(i, t, epoch, ax, ay, recording, logged, rec, edges, order, ev_t, ev_kind, ev_i, ev_j, ev_f):
+    """Disc ``i`` (flying with the acceleration ``ax``, ``ay`` until now) meets the piston at ``t``: both bounce
+    (momentum exchanged along y), the piston's path starts afresh from there and its impacts count one more; the
+    disc's record holds its new flight. Logged (when ``recording``, in row ``logged``) as a ``WALL`` record whose
+    ``yj`` and ``vyj`` are the piston's height and velocity after."""
     p = edges.shape[0] - SLOTS
-    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], 0.0, 0.0, 0.0)
+    xi, yi, vxi, vyi = advance(rec[i, X], rec[i, Y], rec[i, VX], rec[i, VY], t - rec[i, T], ax, ay, 0.0)
     h, u = now(t, edges)
     vyi, u = piston_bounce(rec[i, M], vyi, edges[p + P_MASS], u)
     edges[p + P_H], edges[p + P_U], edges[p + P_T] = h, u, t
@@ -98,14 +99,15 @@ def rebase(shift, epoch, rec, qt, bheap, bht, bpos, barg, seg, edges, laws_end):
     reblock(qt, bheap, bht, bpos, barg)  # the shift may round two times to one: order them anew
 
 
-def put(edges: np.ndarray, mass: float, numbers: np.ndarray, width: float) -> None:
+def put(edges: np.ndarray, mass: float, numbers: np.ndarray, width: float, gy: float = 0.0) -> None:
     """Write a state's piston numbers (height, velocity, internal reference time, impacts, pressure:
     :attr:`~discsim.engines.event_driven.state.EventDrivenState.piston`) into ``edges``' last slots, for a piston of
-    ``mass`` in a box ``width`` wide (its fall's acceleration ``pressure * width / mass``, 0 for a kinematic lid)."""
+    ``mass`` in a box ``width`` wide under gravity ``gy`` along y (its fall's acceleration
+    ``pressure * width / mass - gy``, 0 for a kinematic lid)."""
     height, velocity, ref_time, hits, pressure = (float(v) for v in numbers)
     p = edges.shape[0] - SLOTS
     edges[p + P_MASS] = mass
-    edges[p + P_ACCEL] = 0.0 if mass == np.inf else pressure * width / mass
+    edges[p + P_ACCEL] = 0.0 if mass == np.inf else pressure * width / mass - gy
     edges[p + P_H], edges[p + P_U], edges[p + P_T], edges[p + P_HITS], edges[p + P_PRESSURE] = (
         height, velocity, ref_time, hits, pressure,
     )  # fmt: skip

@@ -2,12 +2,12 @@
 
 Between impacts the piston falls along ``h_k + u_k s - a_k s^2 / 2`` (``s = t - t_k``); its state at time 0 is the
 scene's :class:`~discsim.Piston`, its state after each impact the log's ``WALL`` record (``yj``, ``vyj``), and its
-state now ``sim.piston``. The acceleration ``a = pressure * width / mass`` (0 for a kinematic lid) holds until
-``set_piston`` changes the pressure or the velocity, which the log does not record: a piece whose path under the
-acceleration in force does not reach the next knot held a change (as :func:`discsim.analysis.isobaric.isobaric`
-detects it), and takes the acceleration that joins its two ends (exact at both, in between an approximation: the
-log does not say when the change came); the pieces after it take the new pressure's (``sim.piston``'s) when it
-fits, else the one that joins their ends.
+state now ``sim.piston``. The acceleration ``a = pressure * width / mass`` (plus ``g`` under gravity down along y; 0
+for a kinematic lid) holds until ``set_piston`` changes the pressure or the velocity, which the log does not record:
+a piece whose path under the acceleration in force does not reach the next knot held a change (as
+:func:`discsim.analysis.isobaric.isobaric` detects it), and takes the acceleration that joins its two ends (exact at
+both, in between an approximation: the log does not say when the change came); the pieces after it take the new
+pressure's (``sim.piston``'s) when it fits, else the one that joins their ends.
 
 Example:
     >>> import discsim as ds
@@ -84,8 +84,11 @@ def piston_path(sim) -> PistonPath:
     if now > times[-1]:
         times, heights = np.append(times, now), np.append(heights, piston.height)
         velocities = np.append(velocities, piston.velocity)
+    gravity = getattr(getattr(sim, "laws", None), "gravity", None)  # down along y: the piston's weight
+    fall = 0.0 if gravity is None or given.mass == math.inf else -float(gravity[1])
     per_mass = 0.0 if given.mass == math.inf else width / given.mass
-    accel = _accelerations(times, heights, velocities, given.pressure * per_mass, piston.pressure * per_mass)
+    a_start, a_now = given.pressure * per_mass + fall, piston.pressure * per_mass + fall
+    accel = _accelerations(times, heights, velocities, a_start, a_now)
     return PistonPath(times, heights, velocities, accel)
 
 

@@ -43,7 +43,7 @@ def test_the_knots_start_at_the_scene_s_piston_hold_every_impact_and_give_the_he
     assert (path.times[0], path.heights[0], path.velocities[0]) == (0.0, piston.height, -0.2)
     assert np.array_equal(path.times[1:-1], hits["time"]) and np.array_equal(path.heights[1:-1], hits["yj"])
     assert (path.times[-1], path.heights[-1], path.velocities[-1]) == (sim.time, sim.piston.height, sim.piston.velocity)
-    assert np.all(path.accel == 0.4 * box.width / 5.0)
+    assert path.accel == pytest.approx(np.full(len(path.accel), 0.4 * box.width / 5.0), rel=1e-14)
     assert path.height(times) == pytest.approx(heights, rel=1e-12)
     assert path.height(times.reshape(4, 10)).shape == (4, 10)
 
@@ -69,6 +69,19 @@ def test_a_pressure_changed_mid_run_is_followed_and_only_the_pieces_that_held_a_
     assert set(nearest.tolist()) == {0, 1, 2} and not np.isclose(path.accel[broken][:, None], pressures).any()
     ends = path.heights[broken + 1]
     assert path.height(path.times[broken + 1] - 1e-15) == pytest.approx(ends, rel=1e-9)
+
+
+def test_under_gravity_the_piston_falls_with_its_weight_too():
+    discs, box = _gas(seed=7)
+    g = 0.3
+    sim = ds.EventDriven(discs, box, piston=ds.Piston(mass=5.0, pressure=0.4, height=_top(discs)), gravity=(0.0, -g))
+    times = np.linspace(0.29, 11.6, 40)
+    heights = _sampled(sim, times)
+    path = piston_path(sim)
+    assert sim.piston.hits > 5 and path.accel == pytest.approx(
+        np.full(len(path.accel), 0.4 * box.width / 5.0 + g), rel=1e-14
+    )
+    assert path.height(times) == pytest.approx(heights, rel=1e-12)
 
 
 def test_a_run_without_a_piston_or_a_log_is_refused_by_name():

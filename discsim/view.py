@@ -280,11 +280,11 @@ def _as_run(source, label: str | None) -> _Run:
 
 def _with_piston(run: _Run, sim) -> _Run:
     """``run`` with the knots of ``sim``'s piston (:func:`~discsim.analysis.piston_path.piston_path`), if it has one."""
-    if getattr(getattr(sim, "scene", None), "piston", None) is None:
-        return run
     from discsim.analysis.piston_path import piston_path
 
-    return replace(run, piston=piston_path(sim))
+    return (
+        run if getattr(getattr(sim, "scene", None), "piston", None) is None else replace(run, piston=piston_path(sim))
+    )
 
 
 # --- packing the data ------------------------------------------------------------------------------------
@@ -444,18 +444,10 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
         "contact_times": _b64(contacts["time"], "<f8"),
         "contact_pairs": _b64(np.column_stack([contacts["i"], contacts["j"]]), "<i4"),
         "max_speed": float(np.quantile(speeds, 0.99)) if len(speeds) else 0.0,  # the fastest 1% saturate
-        "piston": _piston_data(run.piston, t0, t1),
+        "piston": None
+        if run.piston is None
+        else {k: _b64(v, "<f8") for k, v in run.piston.span(t0, t1)._asdict().items()},
     }
-
-
-def _piston_data(path: PistonPath | None, t0: float, t1: float) -> dict | None:
-    """The knots of a piston the page needs for ``[t0, t1]`` (the last at or before ``t0`` on), or None."""
-    if path is None:
-        return None
-    first = max(0, int(np.searchsorted(path.times, t0, side="right")) - 1)
-    last = max(first + 1, int(np.searchsorted(path.times, t1, side="right")))
-    knots = slice(first, last)
-    return {name: _b64(getattr(path, name)[knots], "<f8") for name in ("times", "heights", "velocities", "accel")}
 
 
 def _check_nonempty(run: _Run) -> None:

@@ -51,6 +51,13 @@ class PistonPath(NamedTuple):
         """The piston's height at ``times`` (any shape; before the first knot, from it) as an array of that shape."""
         return self.state(times)[0]
 
+    def span(self, t0: float, t1: float) -> PistonPath:
+        """The knots that give the path over ``[t0, t1]``: the last at or before ``t0`` (or the first) to the last at or
+        before ``t1``."""
+        first = max(0, int(np.searchsorted(self.times, t0, side="right")) - 1)
+        last = max(first + 1, int(np.searchsorted(self.times, t1, side="right")))
+        return PistonPath(*(knots[first:last] for knots in self))
+
     def state(self, times) -> tuple[np.ndarray, np.ndarray]:
         """``(heights, velocities)`` of the piston at ``times`` (any shape): from the last knot at or before each."""
         t = np.asarray(times, dtype=float)

@@ -679,7 +679,7 @@ def knots(run) -> dict:
     return {k: np.frombuffer(base64.b64decode(v), dtype="<f8") for k, v in run["piston"].items()}
 
 
-def test_the_page_gets_the_piston_s_knots_from_the_span_s_start_and_a_run_without_one_none():
+def test_the_page_gets_the_piston_s_knots_from_the_span_s_start_and_a_run_without_one_none(tmp_path):
     from discsim.analysis.piston_path import piston_path
 
     sim, _, _ = piston_gas()
@@ -691,6 +691,9 @@ def test_the_page_gets_the_piston_s_knots_from_the_span_s_start_and_a_run_withou
     (late,) = page_data(ds.view(sim, path=None, start=5.0, until=8.0))["runs"]
     kept = knots(late)["times"]
     assert kept[0] <= 5.0 < kept[1] and kept[-1] <= 8.0 and set(kept) <= set(path.times)
+    sim.save(tmp_path / "piston.dsc")  # a checkpoint that holds its log: the same knots
+    (saved,) = page_data(ds.view(tmp_path / "piston.dsc", path=None))["runs"]
+    assert {k: v.tolist() for k, v in knots(saved).items()} == {k: v.tolist() for k, v in got.items()}
     (plain,) = page_data(ds.view(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5), path=None))["runs"]
     assert plain["piston"] is None
 

@@ -712,6 +712,17 @@ def test_the_page_draws_the_piston_where_it_was_at_each_frame(tmp_path):
     got = np.array([d["height"] for d in drawn])
     assert got.tolist() == piston_path(sim).height(times).tolist()  # the same arithmetic, bit for bit
     assert got == pytest.approx(heights, rel=1e-12)  # where the run had it
+    # The screenshot shows the bar in the piston's blue grey, which nothing else is drawn in.
+    shot = tmp_path / "piston.png"
+    subprocess.run(
+        browser_args("--window-size=900,900", "--virtual-time-budget=1000", f"--screenshot={shot}", page.path.as_uri()),
+        capture_output=True,
+        timeout=120,
+        check=False,
+    )
+    assert shot.exists(), "Chromium wrote no screenshot"
+    pixels = matplotlib.image.imread(shot)[..., :3]
+    assert (np.abs(pixels - np.array([0x37, 0x47, 0x4F]) / 255.0).max(axis=2) < 0.03).sum() > 100
     plain = ds.view(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5), tmp_path / "plain.html")
     assert (
         drive(

@@ -9,6 +9,8 @@ Lengths are drawn to scale: discs are circles of their true radii and the
 axes have equal aspect.
 An engine's sensors are drawn under the discs, as the viewer draws them; its segments where they are at the
 time drawn (a moving one from ``p0 + v t`` to ``p1 + v t``, at each frame of an animation).
+A run's piston (``sim.piston``) is a thick bar across the box where it is at the time drawn, the box above it
+shaded (at each frame of an animation).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
 from discsim._plot_gif import save_gif
+from discsim._plot_piston import draw_piston, piston_mover
 from discsim._plot_sensors import draw_segments, draw_sensors, segment_lines
 from discsim.errors import InvalidArgumentError
 from discsim.events import ADD, COLLISION
@@ -140,6 +143,7 @@ def plot_state(sim_or_discs, ax=None, box=None, *, arrows: bool = True, marks: b
             quiver.set_clip_path(Rectangle((0.0, 0.0), box.width, box.height, transform=ax.transData))
     draw_segments(ax, getattr(sim_or_discs, "segments", ()), 0.0 if time is None else time)  # (Discs have none)
     _setup(ax, box, getattr(sim_or_discs, "sensors", ()))
+    draw_piston(ax, sim_or_discs)  # a bar where the piston is now, the box above it shaded (none: nothing)
     if box is None and len(positions):
         r = float(discs.radii.max())
         ax.set_xlim(positions[:, 0].min() - 2 * r, positions[:, 0].max() + 2 * r)
@@ -575,7 +579,7 @@ def animate(
     width = 4.5 * len(sims)
     fig, axes = plt.subplots(1, len(sims), figsize=(width, max(2.5, 4.5 * aspect + 0.9)), squeeze=False)
     truths = [s for s in sims if type(s).__name__ == "EventDriven"]
-    panels, outlines, dynamic = [], [], []
+    panels, outlines, dynamic, pistons = [], [], [], []
     for ax, s, paths in zip(axes[0], sims, paths_of, strict=True):
         start, ids = s.run_context.log_origin(s.discs)  # the log names discs by id: one column each
         origin = LastRecords.at_start(start, float(s.start_time), ids)
@@ -607,6 +611,7 @@ def animate(
         moving = walls if any(segment.moving for segment in segments) else None  # moved at each frame
         dynamic += [] if moving is None else [moving]
         _setup(ax, s.box, getattr(s, "sensors", ()))
+        pistons.append(piston_mover(ax, s, times, dynamic))  # where the piston is at each frame (none: no-op)
         ax.set_xlim(limits[0], limits[1])
         ax.set_ylim(limits[2], limits[3])
         ax.set_title(type(s).__name__, fontsize=10, loc="left")
@@ -632,6 +637,8 @@ def animate(
                 moving.set_segments(segment_lines(segments, float(times[k])))
         for t, patch in outlines:
             patch.set_visible(t <= times[k])
+        for move in pistons:
+            move(k)
         frame = (times[k] - times[0]) / dt if dt > 0 else math.nan
         on_frame = dt > 0 and abs(frame - round(frame)) < 1e-9
         clock.set_text(f"t = {times[k]:.3f}" + (f"  (PIT frame {round(frame)})" if on_frame else ""))

@@ -36,7 +36,7 @@ import html
 import json
 import math
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -47,6 +47,7 @@ from discsim.events import ADD, COLLISION, ENTER, EVENT_DTYPE, EventKind, disc_c
 from discsim.trajectory import LastRecords, falling, flight, turning_history
 
 if TYPE_CHECKING:
+    from discsim.analysis.piston_path import PistonPath
     from discsim.model import Box
 
 __all__ = ["COLOUR_MODES", "DEFAULT_MAX_EVENTS", "View", "view"]
@@ -82,6 +83,7 @@ class _Run:
     gravity: tuple[float, float] | None = None
     turning: tuple | None = None  # a turning_history of the discs by id, or None: the page draws no marks
     sensors: tuple = ()  # the run's Sensors, drawn as regions and trip wires
+    piston: PistonPath | None = None  # the knots of the run's piston (a bar where it is), or None: no piston
 
 
 @dataclass(frozen=True)
@@ -254,7 +256,7 @@ def _from_path(path: Path, label: str | None) -> _Run:
             log_path = path.parent / log_path.name
         _, segments, dt, sensors = _checkpoint_scene(path)
         return _from_log_file(log_path, label or path.name, type(sim).__name__, segments, dt, sensors)
-    return _from_engine(sim, label or path.name)
+    return _with_piston(_from_engine(sim, label or path.name), sim)
 
 
 def _as_run(source, label: str | None) -> _Run:
@@ -268,12 +270,21 @@ def _as_run(source, label: str | None) -> _Run:
     if isinstance(source, StreamedEvents):
         return _from_stream(source, label or "event log")
     if isinstance(source, Engine):
-        return _from_engine(source, label)
+        return _with_piston(_from_engine(source, label), source)
     msg = (
         f"cannot view a {type(source).__name__}: give an engine (EventDriven or FixedStep, record=True), "
         "a run folder or event-log path, or the StreamedEvents of ds.read_events"
     )
     raise InvalidArgumentError(msg)
+
+
+def _with_piston(run: _Run, sim) -> _Run:
+    """``run`` with the knots of ``sim``'s piston (:func:`~discsim.analysis.piston_path.piston_path`), if it has one."""
+    from discsim.analysis.piston_path import piston_path
+
+    return (
+        run if getattr(getattr(sim, "scene", None), "piston", None) is None else replace(run, piston=piston_path(sim))
+    )
 
 
 # --- packing the data ------------------------------------------------------------------------------------
@@ -433,6 +444,9 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
         "contact_times": _b64(contacts["time"], "<f8"),
         "contact_pairs": _b64(np.column_stack([contacts["i"], contacts["j"]]), "<i4"),
         "max_speed": float(np.quantile(speeds, 0.99)) if len(speeds) else 0.0,  # the fastest 1% saturate
+        "piston": None
+        if run.piston is None
+        else {k: _b64(v, "<f8") for k, v in run.piston.span(t0, t1)._asdict().items()},
     }
 
 

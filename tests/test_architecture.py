@@ -34,6 +34,7 @@ FLOORS = {
         "plot",
         "_plot_sensors",
         "_plot_gif",
+        "_plot_piston",
         "view",
         "scenarios",
         "__init__",

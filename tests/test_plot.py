@@ -357,3 +357,46 @@ def test_the_still_plots_draw_a_moving_segment_where_it_is_at_their_time():
     pit_ax, pic_ax = plot.plot_case(sim, pit).axes[:2]
     assert drawn_segments(pic_ax) == [PADDLE_AT[4.0], FLOOR]  # at the last frame
     assert not [c for c in pit_ax.collections if c.get_gid() == "segments"]  # PIT's run has no segments
+
+
+def piston_run():
+    """A small gas under a piston, and the piston's height when the run stood at 2.5 and at 6."""
+    discs, _ = ds.random_gas(8, 0.15, seed=2, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 1.5, 80.0)
+    top = float((discs.positions[:, 1] + discs.radii).max()) + 3.0
+    sim = ds.EventDriven(discs, box, piston=ds.Piston(mass=5.0, pressure=0.4, height=top, velocity=-0.2))
+    at = {t: sim.run(until=t).piston.height for t in (2.5, 6.0)}
+    return sim, at
+
+
+def piston_artists(ax) -> dict:
+    return {a.get_gid(): a for a in [*ax.lines, *ax.patches] if (a.get_gid() or "").startswith("piston")}
+
+
+def test_plot_state_draws_the_piston_where_it_is_and_shades_the_box_above_it():
+    sim, at = piston_run()
+    drawn = piston_artists(plot.plot_state(sim))
+    assert set(drawn) == {"piston", "piston above"}
+    assert list(drawn["piston"].get_ydata()) == [at[6.0]] * 2 and list(drawn["piston"].get_xdata()) == [
+        0,
+        sim.box.width,
+    ]
+    shade = drawn["piston above"]
+    assert (shade.get_y(), shade.get_y() + shade.get_height()) == pytest.approx((at[6.0], sim.box.height), rel=1e-15)
+    assert not piston_artists(plot.plot_state(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5)))
+
+
+def test_animate_draws_the_piston_where_it_is_at_each_frame(tmp_path):
+    sim, at = piston_run()
+    anim = plot.animate(sim, times=[2.5, 6.0])  # the figure shows the first frame
+    bar = piston_artists(anim._fig.axes[0])["piston"]
+    assert bar.get_ydata()[0] == pytest.approx(at[2.5], rel=1e-12)
+    plot.close(anim)
+    anim = plot.animate(sim, tmp_path / "piston.gif", times=[2.5, 6.0], dpi=30)  # saving draws to the last frame
+    drawn = piston_artists(anim._fig.axes[0])
+    assert drawn["piston"].get_ydata()[0] == pytest.approx(at[6.0], rel=1e-12)
+    assert drawn["piston above"].get_y() == drawn["piston"].get_ydata()[0]
+    plot.close(anim)
+    plain = plot.animate(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5))
+    assert not piston_artists(plain._fig.axes[0])
+    plot.close(plain)

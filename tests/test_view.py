@@ -661,3 +661,74 @@ def test_the_page_draws_a_moving_segment_where_it_is_at_each_time(tmp_path):
     for t, (paddle, floor) in zip(times, drawn, strict=True):
         assert paddle == [p0x + vx * t, p0y + vy * t, p1x + vx * t, p1y + vy * t]  # p0 + v t, p1 + v t
         assert floor == [*FLOOR[0], *FLOOR[1]]  # a fixed segment stays put
+
+
+def piston_gas():
+    """A small gas under a piston, and the piston's height sampled (run stopped) at some times."""
+    discs, _ = ds.random_gas(8, 0.15, seed=2, periodic=False)
+    box = ds.Box(discs.positions[:, 0].max() + 1.5, 80.0)
+    top = float((discs.positions[:, 1] + discs.radii).max()) + 3.0
+    sim = ds.EventDriven(discs, box, piston=ds.Piston(mass=5.0, pressure=0.4, height=top, velocity=-0.2))
+    times, heights = np.linspace(0.37, 9.9, 12), []
+    for t in times:
+        heights.append(sim.run(until=float(t)).piston.height)
+    return sim, times, np.array(heights)
+
+
+def knots(run) -> dict:
+    return {k: np.frombuffer(base64.b64decode(v), dtype="<f8") for k, v in run["piston"].items()}
+
+
+def test_the_page_gets_the_piston_s_knots_from_the_span_s_start_and_a_run_without_one_none(tmp_path):
+    from discsim.analysis.piston_path import piston_path
+
+    sim, _, _ = piston_gas()
+    path = piston_path(sim)
+    (run,) = page_data(ds.view(sim, path=None))["runs"]
+    got = knots(run)
+    for name in ("times", "heights", "velocities", "accel"):
+        assert got[name].tolist() == getattr(path, name).tolist()
+    (late,) = page_data(ds.view(sim, path=None, start=5.0, until=8.0))["runs"]
+    kept = knots(late)["times"]
+    assert kept[0] <= 5.0 < kept[1] and kept[-1] <= 8.0 and set(kept) <= set(path.times)
+    sim.save(tmp_path / "piston.dsc")  # a checkpoint that holds its log: the same knots
+    (saved,) = page_data(ds.view(tmp_path / "piston.dsc", path=None))["runs"]
+    assert {k: v.tolist() for k, v in knots(saved).items()} == {k: v.tolist() for k, v in got.items()}
+    (plain,) = page_data(ds.view(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5), path=None))["runs"]
+    assert plain["piston"] is None
+
+
+def test_the_page_draws_the_piston_where_it_was_at_each_frame(tmp_path):
+    from discsim.analysis.piston_path import piston_path
+
+    sim, times, heights = piston_gas()
+    page = ds.view(sim, tmp_path / "piston.html")
+    script = (
+        "const out = []; for (const t of TIMES) { discsim.seek(t); out.push(discsim.piston(0)); }"
+        "document.getElementById('ds-readout').textContent = JSON.stringify(out);"
+    ).replace("TIMES", json.dumps(times.tolist()))
+    drawn = drive(page.path, tmp_path, script)
+    assert [d["time"] for d in drawn] == times.tolist()
+    got = np.array([d["height"] for d in drawn])
+    assert got.tolist() == piston_path(sim).height(times).tolist()  # the same arithmetic, bit for bit
+    assert got == pytest.approx(heights, rel=1e-12)  # where the run had it
+    # The screenshot shows the bar in the piston's blue grey, which nothing else is drawn in.
+    shot = tmp_path / "piston.png"
+    subprocess.run(
+        browser_args("--window-size=900,900", "--virtual-time-budget=1000", f"--screenshot={shot}", page.path.as_uri()),
+        capture_output=True,
+        timeout=120,
+        check=False,
+    )
+    assert shot.exists(), "Chromium wrote no screenshot"
+    pixels = matplotlib.image.imread(shot)[..., :3]
+    assert (np.abs(pixels - np.array([0x37, 0x47, 0x4F]) / 255.0).max(axis=2) < 0.03).sum() > 100
+    plain = ds.view(ds.EventDriven(*ds.random_gas(10, 0.2)).run(until=0.5), tmp_path / "plain.html")
+    assert (
+        drive(
+            plain.path,
+            tmp_path,
+            "document.getElementById('ds-readout').textContent = JSON.stringify(discsim.piston(0));",
+        )
+        is None
+    )

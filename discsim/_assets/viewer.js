@@ -20,6 +20,7 @@
   const OBSTACLE = "#8c8c8c";
   const SENSOR = "#b8860b";  // dark goldenrod: apart from tab10 and viridis
   const SENSOR_SHAPES = { 1: "circle", 2: "rectangle", 3: "line" };
+  const PISTON = "#37474f", PISTON_BAR = 6;  // blue grey: the piston's bar (pixels thick) and the box above it
   const FLASH_SECONDS = 0.3;  // of playing (real time): a sensor stays lit this long after a disc enters it
   // viridis at 9 evenly spaced points, interpolated linearly
   const VIRIDIS = [[68, 1, 84], [71, 44, 122], [59, 81, 139], [44, 113, 142], [33, 144, 141],
@@ -68,6 +69,8 @@
     run.rec = new Int32Array(run.n);
     run.angle = new Float64Array(run.n);
     run.drawnTime = NaN;
+    run.piston = r.piston ? pistonKnots(r.piston) : null;  // a piston's knots, or null: none
+    run.pistonHeight = NaN;  // its height last drawn
     return run;
   });
   const T0 = DATA.span[0], T1 = DATA.span[1];
@@ -150,6 +153,37 @@
       const sx = s[4] * t, sy = s[5] * t;
       return [s[0] + sx, s[1] + sy, s[2] + sx, s[3] + sy];
     });
+  }
+
+  // A piston (the box's top wall as a body: discsim.Piston): its knots, the state after each and the acceleration
+  // of the piece that follows it (discsim.analysis.piston_path).
+  function pistonKnots(p) {
+    return { times: decode(p.times, Float64Array), heights: decode(p.heights, Float64Array),
+             velocities: decode(p.velocities, Float64Array), accel: decode(p.accel, Float64Array) };
+  }
+
+  // The piston's height at t: from its last knot at or before t (the first before it), h + s (u - a s / 2), the
+  // arithmetic of PistonPath.state.
+  function pistonHeight(piston, t) {
+    let lo = 0, hi = piston.times.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (piston.times[mid] <= t) lo = mid + 1; else hi = mid;
+    }
+    const k = Math.max(0, lo - 1), s = t - piston.times[k];
+    return piston.heights[k] + s * (piston.velocities[k] - 0.5 * piston.accel[k] * s);
+  }
+
+  // The piston at t: the box above it shaded (no gas there), a thick bar across the box on top of the gas.
+  function drawPiston(ctx, run, X, Y, z, t) {
+    if (!run.piston) return;
+    const h = pistonHeight(run.piston, t), box = run.box;
+    run.pistonHeight = h;
+    ctx.fillStyle = PISTON;
+    ctx.globalAlpha = 0.18;
+    ctx.fillRect(X(0), Y(box.height), box.width * z, (box.height - h) * z);
+    ctx.globalAlpha = 1;
+    ctx.fillRect(X(0), Y(h) - PISTON_BAR, box.width * z, PISTON_BAR);
   }
 
   function drawSensors(ctx, run, X, Y, z) {
@@ -290,6 +324,7 @@
     if (box.periodic) ctx.clip();  // discs crossing a periodic edge show on both sides
     const shifts = box.periodic ? [-1, 0, 1] : [0];
     drawSensors(ctx, run, X, Y, z);
+    drawPiston(ctx, run, X, Y, z, t);
     for (let d = 0; d < run.n; d++) {
       const r = run.radii[d];
       if (!Number.isFinite(run.x[d])) continue;  // not there at t (added later, or removed)
@@ -596,6 +631,12 @@
     return panels[panel].run.drawnSegments.map((s) => s.slice());
   }
 
+  // The piston last drawn on a panel: {time, height}, or null without one.
+  function piston(panel = 0) {
+    const run = panels[panel].run;
+    return run.piston ? { time: run.drawnTime, height: run.pistonHeight } : null;
+  }
+
   // Writes {time, positions: [panel][disc][x, y]} into <pre id="ds-readout"> for tools that read the DOM.
   function readout() {
     const out = { time: state.t, drawn: panels.map((p) => p.run.drawnTime), positions: panels.map((_, k) => positions(k)) };
@@ -618,7 +659,7 @@
   window.addEventListener("resize", () => { layout(); render(); });
 
   window.discsim = {
-    seek, time: () => state.t, positions, angles, sensors, segments, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
+    seek, time: () => state.t, positions, angles, sensors, segments, piston, play, pause, step, nextEvent, previousEvent, setSpeed, setFps,
     setColour, setZoom, setArrows, zoom: () => state.zoom, readout, span: [T0, T1], panels: panels.length, playing: () => state.playing,
     labels: runs.map((r) => r.label), eventTimes: () => eventTimes.slice(),
   };

@@ -267,10 +267,9 @@ class EventDriven(PistonRun, Turning, RunStops, Engine):
 
     def _set_discs(self, indices: np.ndarray, positions: np.ndarray | None, velocities: np.ndarray) -> None:
         self._check_piston_edit(indices, positions, velocities)  # before any disc changes
-        set_disc = self._backend.set_disc
         for k, i in enumerate(indices.tolist()):
             vx, vy = velocities[k].tolist()
-            set_disc(i, vx, vy, None if positions is None else tuple(positions[k].tolist()))
+            self._backend.set_disc(i, vx, vy, None if positions is None else tuple(positions[k].tolist()))
 
     def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene, last=None) -> None:
         """A fresh start at ``time`` from the discs of ``scene`` (``keep``, then ``added``): new cell grid, new

@@ -118,8 +118,7 @@ class NumbaBackend(CompiledReads):
         elif law_of_motion is not None or collision_law is not None or interpreted:
             variants = _variants()
             self._lp = SimpleNamespace(**variants.with_physics(law_of_motion, collision_law, interpreted=interpreted))
-        if interpreted:
-            self.name = "python"
+        self.name = "python" if interpreted else "numba"
         box = self.box
         nx, ny = grid.nx, grid.ny
         # The cells' edges: x of the columns' left sides and the box's width, then y of the rows' lower sides
@@ -416,8 +415,7 @@ class NumbaBackend(CompiledReads):
         if position is not None:
             x, y = float(position[0]), float(position[1])
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
-        if moved and self.scene.sensors:  # its sides of the sensors are where it is now (put back where it is, a
-            # centre on an edge keeps its side: taken afresh, it was outside and entered again at once)
+        if moved and self.scene.sensors:  # its sides are where it is now (put back, a centre on an edge keeps its own)
             sensors, n = self.scene.sensors, len(rec)
             self._rest[n + k * len(sensors) : n + (k + 1) * len(sensors)] = inside_table(sensors, [[x, y]])[0]
         held: list[int] = []

@@ -698,6 +698,7 @@ def test_the_page_gets_the_piston_s_knots_from_the_span_s_start_and_a_run_withou
     assert plain["piston"] is None
 
 
+@pytest.mark.slow  # (3 s in the browser; the page's knots are checked quick above)
 def test_the_page_draws_the_piston_where_it_was_at_each_frame(tmp_path):
     from discsim.analysis.piston_path import piston_path
 

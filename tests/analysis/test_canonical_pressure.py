@@ -49,6 +49,7 @@ def test_the_quick_mode_writes_its_csv(canonical_mc, tmp_path):
     assert lines[0].startswith("n,packing,z,z_err") and len(lines) == 2
 
 
+@pytest.mark.slow  # (4 s)
 def test_thermo_z_is_independent_of_the_reading_of_kt_at_large_n():
     # The correction is (Z - 1) / (N - 1): at N = 2000 it is below the error of a short run, as before.
     sim = ds.EventDriven(*ds.random_gas(2000, 0.3, seed=0)).run(until=4.0)

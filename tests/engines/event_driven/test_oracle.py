@@ -57,13 +57,14 @@ def test_mixed_radii_masses_and_obstacles_follow_the_oracle(periodic):
 
 
 @pytest.mark.slow_on_python  # (the pure-Python loop's oracle runs cover it: test_equal_discs_follow_the_oracle)
-@pytest.mark.parametrize("queue", ["heap", "sorted"])
+@pytest.mark.parametrize("queue", ["heap", pytest.param("sorted", marks=pytest.mark.slow)])  # (the compiled loop
+# has one queue of its own: its two cases run the same events)
 def test_dense_gas_follows_the_oracle_with_the_other_queues(queue):
     discs, box = ds.random_gas(36, 0.6, periodic=True, seed=3)
     _lockstep_times(ds.EventDriven(discs, box, queue=queue), 300)
 
 
-@pytest.mark.slow_on_python
+@pytest.mark.slow  # (4 s; the oracle runs above cover the default cells)
 def test_large_cells_follow_the_oracle():
     discs, box = ds.random_gas(50, 0.2, periodic=True, seed=4)
     _lockstep_times(ds.EventDriven(discs, box, cell_size=box.width / 3.5), 200)

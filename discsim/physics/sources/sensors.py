@@ -135,6 +135,17 @@ def rectangle_time(
         if sy == 0:
             ty = INF
         return tx if tx < ty else ty
+    if x0 < x < x1 and y0 < y < y1:  # inside by roundoff, just after leaving: on the nearest edge, whence it
+        # enters at once only moving inwards (a hair in and moving out, it would enter and leave at one instant)
+        near = min(x - x0, x1 - x, y - y0, y1 - y)
+        if near == x - x0:
+            x = x0
+        elif near == x1 - x:
+            x = x1
+        elif near == y - y0:
+            y = y0
+        else:
+            y = y1
     start = 0.0  # from now, each coordinate's next entry into its slab; both in at once: the entry
     px, py, ux, uy = x, y, vx, vy
     for _ in range(16):  # each coordinate enters its slab at most twice along one flight

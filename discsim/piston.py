@@ -115,12 +115,15 @@ class PistonState:
         velocity (float): its velocity along y now (length / time).
         mass, pressure (float): as the :class:`Piston` was given (``pressure`` as last set).
         hits (int): the impacts of discs on it so far.
+        since (float): the time of the last ``set_piston`` (0.0 if none in this process: a run loaded from a
+            checkpoint starts from its load).
     """
 
-    __slots__ = ("height", "hits", "mass", "pressure", "velocity")
+    __slots__ = ("height", "hits", "mass", "pressure", "since", "velocity")
 
-    def __init__(self, height: float, velocity: float, mass: float, pressure: float, hits: int):
+    def __init__(self, height: float, velocity: float, mass: float, pressure: float, hits: int, since: float = 0.0):
         self.height, self.velocity, self.mass, self.pressure, self.hits = height, velocity, mass, pressure, hits
+        self.since = since
 
     def __repr__(self) -> str:
         return f"PistonState(height={self.height!r}, velocity={self.velocity!r}, hits={self.hits})"

@@ -132,6 +132,9 @@ def isobaric(sim, since: float | str | None = None) -> IsobaricAverages:
     reached, u_before = at(h[:-1], u[:-1], accel, gap)  # type: ignore[arg-type]  # (elementwise)
     broken = np.flatnonzero(~np.isclose(reached, h[1:], rtol=1e-9, atol=1e-12 * (1.0 + abs(h).max())))
     start = float(t[broken[-1] + 1]) if len(broken) else float(t[0])
+    changed = float(getattr(piston, "since", 0.0))  # the last set_piston: its first impact after on, or none yet
+    if changed > start:
+        start = float(t[np.searchsorted(t, changed, side="left")]) if changed <= t[-1] else now
     edited = events["time"][np.isin(events["kind"], (SET, ADD, REMOVE))]
     if len(edited) and edited.max() >= start:
         start = float(t[np.searchsorted(t, edited.max(), side="right")]) if edited.max() < t[-1] else now

@@ -28,10 +28,13 @@ class PistonRun:
 
     _backend: Backend
     box: Box
+    time: float
     scene: Scene
     laws: Any
     #: The pressure and velocity :meth:`set_piston` asks for while the backend starts afresh (None: as they are).
     _piston_asked: tuple[float | None, float | None] = (None, None)
+    #: The time of the last :meth:`set_piston` (what ``ds.thermo`` averages starts after it).
+    _piston_since: float = 0.0
 
     if TYPE_CHECKING:
 
@@ -45,7 +48,7 @@ class PistonRun:
         if self.scene.piston is None:
             return None
         height, velocity, hits, pressure = self._piston_now()
-        return PistonState(height, velocity, self.scene.piston.mass, pressure, hits)
+        return PistonState(height, velocity, self.scene.piston.mass, pressure, hits, self._piston_since)
 
     def set_piston(self, *, pressure: float | None = None, velocity: float | None = None):
         """Change the piston's pressure (and so the force on it) or its velocity from now on; returns ``self``.
@@ -77,6 +80,7 @@ class PistonRun:
             self._restructure(np.arange(len(discs)), None, self.scene.but(discs), self._backend.last_event())
         finally:
             self._piston_asked = (None, None)
+        self._piston_since = float(self.time)
         return self
 
     # --- for the engine ----------------------------------------------------------------------

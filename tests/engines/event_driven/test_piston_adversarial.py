@@ -98,19 +98,19 @@ def test_a_kinematic_lid_closing_on_a_disc_stops_with_a_clear_error():
         sim.run(until=7.5, events=3000)  # (the events' limit: without it this hangs)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="not fixed: isobaric() sees a set_piston only as a mismatch of the piston's path at the next impact; "
-    "with no impact since, it averages the span before the change and labels it with the new pressure (Z wrong)",
-)
+# isobaric() saw a set_piston only as a mismatch of the piston's path at the next impact: with none since, it
+# averaged the span before the change under the new pressure. sim.piston.since now bounds the span.
 def test_thermo_right_after_set_piston_does_not_average_the_old_pressure_span():
     discs, _ = ds.random_gas(20, 0.2, seed=4, periodic=False)
     box = ds.Box(discs.positions[:, 0].max() + 2.0, 100.0)
     piston = ds.Piston(mass=5.0, pressure=0.4, height=float((discs.positions[:, 1] + discs.radii).max()) + 1.0)
     sim = ds.EventDriven(discs, box, piston=piston).run(until=2.0)
     sim.set_piston(pressure=1.0)
+    assert sim.piston.since == 2.0
     with pytest.raises(TimeError):  # nothing at pressure 1 to average yet
         ds.thermo(sim)
+    sim.run(until=12.0)
+    assert ds.thermo(sim).since >= 2.0
 
 
 def test_a_piston_hit_is_a_contact_on_the_top_surface_at_the_speed_the_two_approached():

@@ -41,6 +41,7 @@ def test_demo_prints_the_table_and_writes_the_figures(tmp_path, capsys):
     assert str(out.resolve()) in text
 
 
+@pytest.mark.slow  # (3 s; the demo's quick test writes its figures)
 def test_demo_without_gif_and_with_another_policy(tmp_path, capsys):
     assert cli.main(["demo", "--out", str(tmp_path), "--no-gif", "--policy", "revert"]) == 0
     assert "PIT (revert)" in capsys.readouterr().out

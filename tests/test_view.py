@@ -111,6 +111,7 @@ def test_the_page_draws_pit_and_pic_where_trajectory_puts_them(tmp_path):
         assert_same_positions(pic_drawn, pic_expected[k])
 
 
+@pytest.mark.slow  # (2 s in the browser)
 def test_a_periodic_gas_wraps_like_trajectory_and_a_window_replays_exactly(tmp_path):
     discs, box = ds.random_gas(150, 0.35, periodic=True, seed=3)
     sim = ds.EventDriven(discs, box).run(until=4.0)
@@ -436,6 +437,7 @@ def test_the_page_draws_parabolas_and_rest_where_trajectory_puts_them(tmp_path):
     assert_same_positions(r["positions"][0], sim.trajectory([5.5])[0])
 
 
+@pytest.mark.slow  # (2 s in the browser)
 def test_the_page_marks_each_disc_s_angle_as_frames_give_it(tmp_path):
     sim = ds.EventDriven(*ds.random_gas(20, 0.3, seed=4), roughness=0.5).run(until=3.0)
     assert sim.counts["collisions"] > 5

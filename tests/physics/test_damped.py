@@ -158,6 +158,7 @@ def test_a_disc_sinking_at_its_terminal_velocity_under_a_huge_drag_meets_a_still
     assert _separation(np.array([t]), (-0.3, -3.0), (0.0, 0.0), (0.0, 9.81), gamma)[0] == pytest.approx(2.0, rel=1e-12)
 
 
+@pytest.mark.slow  # (2 s; test_a_falling_disc_against_a_still_one_is_never_missed stays quick)
 @settings(max_examples=300, deadline=None)
 @given(
     st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), speed, speed, st.floats(-3.0, 3.0, allow_subnormal=False),

@@ -270,7 +270,7 @@ def test_pressure_under_gravity_is_refused_with_a_reason():
 
 # --- the brute-force oracle, in lock-step ----------------------------------------------------------------------
 @pytest.mark.slow_on_python
-@pytest.mark.parametrize("restitution", [1.0, 0.7])
+@pytest.mark.parametrize("restitution", [1.0, pytest.param(0.7, marks=pytest.mark.slow)])  # (2 s each)
 def test_a_gas_under_gravity_follows_the_oracle(every_backend, restitution):
     from oracle import next_event_under_gravity, scattered_discs
 

@@ -27,7 +27,7 @@ def _lockstep_times(sim, steps):
 
 
 @pytest.mark.slow_on_python  # (4 s interpreted; the numba case stays quick)
-@pytest.mark.parametrize("periodic", [False, True])
+@pytest.mark.parametrize("periodic", [False, pytest.param(True, marks=pytest.mark.slow)])  # (periodic: 4 s)
 @pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)])
 def test_equal_discs_follow_the_oracle(periodic, seed):  # seed 0 quick; 1 and 2 (3 s each) repeat it: slow
     discs, box = ds.random_gas(40, 0.35, periodic=periodic, seed=seed)

@@ -37,9 +37,11 @@ class PistonPath(NamedTuple):
     """A piston's knots: its state at time 0, after each impact and now, and the acceleration of the piece after each.
 
     Attributes:
-        times ``(K,)``: the knots' times (time units), increasing. heights ``(K,)``: the piston's height after each
-        (length). velocities ``(K,)``: its velocity along y after each (length / time). accel ``(K,)``: its downward
-        acceleration from each knot to the next (length / time^2; 0 for a kinematic lid).
+        times (np.ndarray): ``(K,)`` the knots' times (time units), increasing.
+        heights (np.ndarray): ``(K,)`` the piston's height after each (length).
+        velocities (np.ndarray): ``(K,)`` its velocity along y after each (length / time).
+        accel (np.ndarray): ``(K,)`` its downward acceleration from each knot to the next (length / time^2; 0 for a
+            kinematic lid).
     """
 
     times: np.ndarray

@@ -41,6 +41,7 @@ def test_event_driven_z_is_the_canonical_one_at_n_20(canonical_mc):
     assert md["z_naive"] - mc["z"] > 4 * math.hypot(mc["z_err"], md["z_naive_err"])  # kT = K / N: too high
 
 
+@pytest.mark.slow  # (24 s: numba compiles the Monte Carlo)
 def test_the_quick_mode_writes_its_csv(canonical_mc, tmp_path):
     if not numba_available():
         pytest.skip("the Monte Carlo is compiled by numba")

@@ -240,6 +240,7 @@ def test_gravity_too_strong_for_the_box_is_refused_naming_it(engine, gravity):
     assert strong.laws.gravity == (0.0, -1e90)
 
 
+@pytest.mark.slow  # (3 s)
 @pytest.mark.xfail(
     strict=True,
     raises=AssertionError,

@@ -17,6 +17,7 @@ import numpy as np
 from discsim.cells import neighbour_pairs
 from discsim.engines.event_driven.piston import check_room
 from discsim.engines.event_driven.protocol import Backend
+from discsim.engines.event_driven.squeeze import Crush, lid_crush, squeeze
 from discsim.errors import Interrupted, InvalidArgumentError, JammedError
 from discsim.model import Box, Discs
 from discsim.scene import Scene
@@ -97,6 +98,7 @@ class RunStops:
         def _take_compiled(self) -> None: ...
         def snapshot(self) -> Discs: ...
         def _restructure(self, keep: np.ndarray, added: Discs | None, scene: Scene, last=None) -> None: ...
+        def _piston_now(self) -> tuple[float, float, int, float]: ...
 
         @property
         def positions(self) -> np.ndarray: ...
@@ -106,6 +108,8 @@ class RunStops:
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None
+        if until != INF or limit is None:
+            self._check_lid(until)
         try:
             if until != INF:
                 return self._chunked(until, limit, log)
@@ -186,6 +190,7 @@ class RunStops:
     _jam_mark: tuple[float, int, int, bool] | None = None  # (time, physical events, events allowed, extended)
     _jam_counts: tuple[int, np.ndarray] | None = None  # (physical events, each disc's counter) half-way there
     _jam_scale: tuple[int, int, float] | None = None  # (edits, physical events, time scale) when last taken
+    _squeeze_units: int = 0  # physical events at the last look for a disc squeezed by a kinematic wall
 
     def _chunked(self, until: float, limit: int | None, log, crossings: int | None = None) -> int:
         """``backend.advance(until, limit, log, crossings)`` in chunks, watching the clock between them.
@@ -228,12 +233,60 @@ class RunStops:
                 self._jammed(mark, units, chunk)
             elif units - mark[1] >= half and self._jam_counts is None:
                 self._jam_counts = (units, backend.disc_counts())
+            if self._kinematic and not 0 <= units - self._squeeze_units < half:
+                self._squeeze_units = units
+                self._check_squeeze(until)
             if k < ask or done == limit:
                 return done  # the time or event limit, an empty queue, or the crossings asked for
             if left is not None:
                 left -= backend.counts()["cell_crossings"] - crossed
                 if left <= 0:
                     return done
+
+    @property
+    def _kinematic(self) -> bool:
+        """Whether a wall moves whatever hits it (a moving segment, a kinematic lid): it may crush a disc."""
+        piston = self.scene.piston
+        return self.scene.moving or (piston is not None and piston.kinematic)
+
+    def _check_lid(self, until: float) -> None:
+        """Refuse, before anything moves, a run to ``until`` past the time a kinematic lid crushes the discs for
+        certain (:func:`~discsim.engines.event_driven.squeeze.lid_crush`): the bounces pile up before it."""
+        piston = self.scene.piston
+        if piston is None or not piston.kinematic:
+            return
+        height, velocity, _, _ = self._piston_now()
+        crush = lid_crush(self.discs.radii, self.box.width, height, velocity)
+        if crush is not None and self.time + crush.after <= until:
+            raise JammedError(self._crush_message(crush, "set_piston(velocity=...)"))
+
+    def _check_squeeze(self, until: float) -> None:
+        """Raise when the last event's disc is squeezed for certain by a kinematic wall before ``until``
+        (:func:`~discsim.engines.event_driven.squeeze.squeeze`); O(N + walls^2), once per half a jam threshold of
+        events. Not under drag or roughness (a bounce may then turn the disc along the walls)."""
+        last = self._backend.last_event()
+        laws = self.laws
+        if last is None or laws.drag or laws.rough:
+            return
+        piston = self.scene.piston
+        lid = None
+        if piston is not None and piston.kinematic:
+            height, velocity, _, _ = self._piston_now()
+            lid = (height, velocity)
+        segments = [segment.at(self.time) for segment in self.scene.segments]
+        positions, velocities = self.positions, self.velocities
+        args = (positions, velocities, self.discs.radii, laws.gravity, last[2], until - self.time)
+        crush = squeeze(self.box, segments, lid, *args)
+        if crush is not None:
+            raise JammedError(self._crush_message(crush, "set_segment_velocity or set_piston"))
+
+    def _crush_message(self, crush: Crush, steer: str) -> str:
+        at = self.time + crush.after
+        return (
+            f"{crush.what} at time {at!r}: the bounces come faster and faster before then (infinitely many), so "
+            f"no run can pass it (the clock is at {self.time!r}); steer the wall ({steer}) or run until an earlier "
+            "time"
+        )
 
     def _jammed(self, mark: tuple[float, int, int, bool], units: int, chunk: int) -> None:
         """The threshold is reached: give a finite cascade of the touching discs its room once, else raise (or

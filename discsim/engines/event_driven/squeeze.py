@@ -12,7 +12,9 @@ it only converges). This module finds such a crush before the run spends for eve
   between their ends until the gap closes, with no third wall, segment or disc it could reach before then (on the
   other discs' present speeds): a crush that nothing but the user (steering the wall) can prevent.
 
-Both return the crush's time from now and what it crushes, for the engine's :class:`~discsim.errors.JammedError`.
+Both return the crush's time from now and what it crushes, for the engine's :class:`~discsim.errors.JammedError`
+(``RunStops._check_squeeze`` asks once per half a jam threshold of events; not in a periodic box, where the
+walls' images would need minimum images along their spans).
 """
 
 from __future__ import annotations

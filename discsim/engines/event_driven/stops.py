@@ -108,8 +108,6 @@ class RunStops:
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None
-        if until != INF or limit is None:
-            self._check_lid(until)
         try:
             if until != INF:
                 return self._chunked(until, limit, log)
@@ -249,36 +247,28 @@ class RunStops:
         piston = self.scene.piston
         return self.scene.moving or (piston is not None and piston.kinematic)
 
-    def _check_lid(self, until: float) -> None:
-        """Refuse, before anything moves, a run to ``until`` past the time a kinematic lid crushes the discs for
-        certain (:func:`~discsim.engines.event_driven.squeeze.lid_crush`): the bounces pile up before it."""
-        piston = self.scene.piston
-        if piston is None or not piston.kinematic:
-            return
-        height, velocity, _, _ = self._piston_now()
-        crush = lid_crush(self.discs.radii, self.box.width, height, velocity)
-        if crush is not None and self.time + crush.after <= until:
-            raise JammedError(self._crush_message(crush, "set_piston(velocity=...)"))
-
     def _check_squeeze(self, until: float) -> None:
-        """Raise when the last event's disc is squeezed for certain by a kinematic wall before ``until``
-        (:func:`~discsim.engines.event_driven.squeeze.squeeze`); O(N + walls^2), once per half a jam threshold of
-        events. Not under drag or roughness (a bounce may then turn the disc along the walls)."""
-        last = self._backend.last_event()
-        laws = self.laws
-        if last is None or laws.drag or laws.rough:
-            return
-        piston = self.scene.piston
+        """Raise when a kinematic wall crushes a disc for certain before ``until``: a kinematic lid that leaves no
+        room for the discs (:func:`~discsim.engines.event_driven.squeeze.lid_crush`), or a wall that squeezes the
+        last event's disc against a wall facing it (:func:`~discsim.engines.event_driven.squeeze.squeeze`; not
+        under drag or roughness, nor in a periodic box). O(N + walls^2), once per half a jam threshold of events,
+        so that it looks at the walls as callbacks and observers left them."""
+        piston, laws = self.scene.piston, self.laws
         lid = None
         if piston is not None and piston.kinematic:
             height, velocity, _, _ = self._piston_now()
             lid = (height, velocity)
+            crush = lid_crush(self.discs.radii, self.box.width, height, velocity)
+            if crush is not None and self.time + crush.after <= until:
+                raise JammedError(self._crush_message(crush, "set_piston(velocity=...)"))
+        last = self._backend.last_event()
+        if last is None or laws.drag or laws.rough or self.box.periodic or (lid is None and not self.scene.moving):
+            return
         segments = [segment.at(self.time) for segment in self.scene.segments]
-        positions, velocities = self.positions, self.velocities
-        args = (positions, velocities, self.discs.radii, laws.gravity, last[2], until - self.time)
+        args = (self.positions, self.velocities, self.discs.radii, laws.gravity, last[2], until - self.time)
         crush = squeeze(self.box, segments, lid, *args)
         if crush is not None:
-            raise JammedError(self._crush_message(crush, "set_segment_velocity or set_piston"))
+            raise JammedError(self._crush_message(crush, "set_segment_velocity"))
 
     def _crush_message(self, crush: Crush, steer: str) -> str:
         at = self.time + crush.after

@@ -86,17 +86,30 @@ def test_a_paddle_against_a_parallel_fixed_segment_crushes_at_the_closed_form_ti
         sim.run(until=30.0)
 
 
-def test_a_lid_closing_on_a_disc_is_refused_before_anything_moves():
+def lid_run():
     lid = ds.Piston(mass=math.inf, pressure=0.0, height=8.0, velocity=-1.0)  # reaches the diameter 1 at t = 7
-    sim = ds.EventDriven(ds.Discs([[5.0, 2.0]], [[0.0, 1.0]], radii=0.5), BOX, piston=lid)
+    return ds.EventDriven(ds.Discs([[5.0, 2.0]], [[0.0, 1.0]], radii=0.5), BOX, piston=lid)
+
+
+@pytest.mark.slow_on_python
+def test_a_lid_closing_on_a_disc_stops_the_run_short_of_the_crush():
+    sim = lid_run()
     with pytest.raises(JammedError, match=r"the kinematic lid reaches height 1.0 and crushes disc 0 .* at time 7.0"):
         sim.run(until=7.5)
-    assert sim.time == 0.0 and sim.counts["wall_hits"] == 0
-    sim.run(until=6.5)  # short of it: runs
+    assert 6.9 < sim.time < 7.0
+    sim._check()
+    sim.set_piston(velocity=0.5)  # going up again: the run goes on
+    sim.run(until=sim.time + 1.0)
+
+
+def test_a_lid_steered_up_by_a_callback_before_the_crush_runs_on():
+    # The crush it was headed for at t = 7 never comes: the check looks at the lid as the callback left it.
+    sim = lid_run()
+    sim.on("wall", lambda sim, contact: sim.set_piston(velocity=1.0) if sim.time > 5.0 else None)
+    sim.run(until=12.0)
+    assert sim.time == 12.0 and sim.piston.velocity == 1.0
+    sim = lid_run().run(until=6.5)  # short of it: runs
     assert sim.piston.height == pytest.approx(1.5)
-    sim.set_piston(velocity=0.0)  # stopped: nothing to crush
-    sim.run(until=20.0)
-    assert sim.time == 20.0
 
 
 def test_a_lid_over_many_discs_is_bounded_by_their_area():
@@ -113,4 +126,4 @@ def test_a_lid_over_many_discs_is_bounded_by_their_area():
     crush = float(np.sum(math.pi * discs.radii**2)) / box.width
     with pytest.raises(JammedError, match="crushes the discs"):
         sim.run(until=top - crush + 1e-9)
-    assert sim.time == 0.0
+    assert sim.time < top - crush

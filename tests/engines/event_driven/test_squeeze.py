@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import discsim as ds
 from discsim.engines.event_driven.squeeze import lid_crush, squeeze
@@ -127,3 +129,31 @@ def test_a_lid_over_many_discs_is_bounded_by_their_area():
     with pytest.raises(JammedError, match="crushes the discs"):
         sim.run(until=top - crush + 1e-9)
     assert sim.time < top - crush
+
+
+@pytest.mark.slow_on_python
+@settings(max_examples=15, deadline=None)
+@given(
+    u=st.floats(0.1, 3.0),
+    x0=st.floats(1.0, 6.0),
+    r=st.floats(0.1, 0.8),
+    ahead=st.floats(0.1, 3.0),
+    flip=st.booleans(),
+    swap=st.booleans(),
+)
+def test_the_crush_time_is_the_closed_form_whichever_wall_and_axis(u, x0, r, ahead, flip, swap):
+    # A paddle at x0 + r + ahead moving at -u towards a disc at rest against the wall x = 0 (mirrored by flip, x and
+    # y swapped by swap): the gap between them reaches 2 r at (x0 + r + ahead - 2 r) / u.
+    def place(x, y, point=True):
+        x = (10.0 - x if point else -x) if flip else x
+        return (y, x) if swap else (x, y)
+
+    xp = x0 + r + ahead
+    velocity = place(-u, 0.0, point=False)
+    paddle = ds.Segment(place(xp, 3.0), place(xp, 7.0), velocity=velocity)
+    sim = ds.EventDriven(ds.Discs([place(x0, 5.0)], [[0.0, 0.0]], radii=r), BOX, segments=[paddle])
+    crush = (xp - 2.0 * r) / u
+    with pytest.raises(JammedError) as caught:
+        sim.run(until=crush + 1.0, events=3 * (sim.jam_events + sim.jam_events_per_disc))
+    said = float(str(caught.value).split(" at time ")[1].split(":")[0])
+    assert said == pytest.approx(crush, rel=1e-9) and sim.time < said

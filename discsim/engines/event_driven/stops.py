@@ -108,6 +108,8 @@ class RunStops:
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None
+        if self._kinematic:
+            self._speed_reference()  # (before the walls squeeze anything: at the first run after an edit)
         try:
             if until != INF:
                 return self._chunked(until, limit, log)
@@ -262,13 +264,59 @@ class RunStops:
             if crush is not None and self.time + crush.after <= until:
                 raise JammedError(self._crush_message(crush, "set_piston(velocity=...)"))
         last = self._backend.last_event()
-        if last is None or laws.drag or laws.rough or self.box.periodic or (lid is None and not self.scene.moving):
+        if last is None or (lid is None and not self.scene.moving):
             return
-        segments = [segment.at(self.time) for segment in self.scene.segments]
-        args = (self.positions, self.velocities, self.discs.radii, laws.gravity, last[2], until - self.time)
-        crush = squeeze(self.box, segments, lid, *args)
-        if crush is not None:
-            raise JammedError(self._crush_message(crush, "set_segment_velocity"))
+        velocities, segments = self.velocities, [segment.at(self.time) for segment in self.scene.segments]
+        if not (laws.drag or laws.rough or self.box.periodic):
+            args = (self.positions, velocities, self.discs.radii, laws.gravity, last[2], until - self.time)
+            crush = squeeze(self.box, segments, lid, *args)
+            if crush is not None:
+                raise JammedError(self._crush_message(crush, "set_segment_velocity"))
+        self._check_speedup(velocities)
+
+    #: A run with kinematic walls raises :class:`~discsim.errors.JammedError` when a disc moves this many times
+    #: faster than the discs' energy (at the last edit) and the walls' speeds allow: a crush that
+    #: :func:`~discsim.engines.event_driven.squeeze.squeeze` cannot prove (several discs squeezed together; drag,
+    #: roughness, a periodic box), whose speeds grow with every bounce (by about the walls' speed each).
+    squeeze_speedup: float = 1e4
+    _speed_scale: tuple[int, float] | None = None  # (edits, speed scale) when taken
+
+    def _check_speedup(self, velocities: np.ndarray) -> None:
+        """The backstop of :meth:`_check_squeeze`: raise on a disc faster than ``squeeze_speedup`` times the speed
+        scale: ``sqrt(sum m v^2 / min m)`` (what the discs' kinetic energy allows one disc at the last edit), the
+        speed of a fall across the box, and the kinematic walls' speeds."""
+        finite = np.isfinite(self.discs.masses)
+        speeds = np.where(finite, np.hypot(velocities[:, 0], velocities[:, 1]), 0.0)
+        scale = self._speed_reference()
+        k = int(np.argmax(speeds)) if len(speeds) else 0
+        if scale > 0.0 and len(speeds) and speeds[k] > self.squeeze_speedup * scale:
+            msg = (
+                f"disc {k} moves at {float(speeds[k]):.6g}, {self.squeeze_speedup:g} times the speed scale of the "
+                f"run ({scale:.6g}: the discs' energy at the last edit, a fall across the box and the kinematic "
+                f"walls' speeds) at time {self.time!r}: kinematic walls squeeze it against others or a wall, and "
+                "its bounces pile up before they close on it; steer the walls (set_segment_velocity, "
+                "set_piston(velocity=...)) or stop the run earlier"
+            )
+            raise JammedError(msg)
+
+    def _speed_reference(self) -> float:
+        """The speed scale of :meth:`_check_speedup`, taken at the first run after each edit (O(N), kept)."""
+        kept = self._speed_scale
+        if kept is not None and kept[0] == self._edits:
+            return kept[1]
+        masses, velocities = self.discs.masses, self.velocities
+        finite = np.isfinite(masses)
+        energy = 0.0
+        if finite.any():
+            energy = float(np.sum(masses[finite] * np.sum(velocities[finite] ** 2, axis=1))) / masses[finite].min()
+        fall = 2.0 * float(np.hypot(*self.laws.gravity)) * float(self.box.width + self.box.height)
+        walls = [float(np.hypot(*segment.velocity)) for segment in self.scene.segments]
+        piston = self.scene.piston
+        if piston is not None and piston.kinematic:
+            walls.append(abs(self._piston_now()[1]))
+        scale = max(math.sqrt(energy + fall), *walls)
+        self._speed_scale = (self._edits, scale)
+        return scale
 
     def _crush_message(self, crush: Crush, steer: str) -> str:
         at = self.time + crush.after

@@ -157,3 +157,28 @@ def test_the_crush_time_is_the_closed_form_whichever_wall_and_axis(u, x0, r, ahe
         sim.run(until=crush + 1.0, events=3 * (sim.jam_events + sim.jam_events_per_disc))
     said = float(str(caught.value).split(" at time ")[1].split(":")[0])
     assert said == pytest.approx(crush, rel=1e-9) and sim.time < said
+
+
+@pytest.mark.slow_on_python
+def test_a_row_of_discs_squeezed_by_a_paddle_stops_once_a_disc_is_far_faster_than_the_run_allows():
+    # Three discs in a row: each next to others, so no certain single-disc crush is proved; the backstop (a disc
+    # squeeze_speedup times faster than the energy and the walls' speeds allow) stops the run short of t = 5.
+    paddle = ds.Segment((8.0, 4.0), (8.0, 6.0), velocity=(-1.0, 0.0))
+    discs = ds.Discs([[1.0, 5.0], [3.0, 5.0], [5.0, 5.0]], np.zeros((3, 2)), radii=0.5)
+    sim = ds.EventDriven(discs, BOX, segments=[paddle])
+    with pytest.raises(JammedError, match=r"disc \d moves at .*10000 times the speed scale of the run \(1:"):
+        sim.run(until=20.0)
+    assert 4.99 < sim.time < 5.0
+    assert np.hypot(*sim.velocities.T).max() > 1e4
+    sim._check()
+
+
+def test_a_paddle_that_batters_a_ball_a_few_times_is_no_squeeze():
+    # A pong rally: the paddle x = 8 - t sends a ball back towards the far wall at each meeting, then is steered
+    # away; the ball gains 2 per hit, far below the backstop.
+    paddle = ds.Segment((8.0, 0.5), (8.0, 9.5), velocity=(-0.2, 0.0))
+    sim = ds.EventDriven(ds.Discs([[4.0, 5.0]], [[1.0, 0.0]], radii=0.5), BOX, segments=[paddle])
+    sim.run(until=15.0)
+    sim.set_segment_velocity(0, (0.0, 0.0))
+    sim.run(until=30.0)
+    assert sim.time == 30.0 and 1.0 < np.hypot(*sim.velocities[0]) < 10.0

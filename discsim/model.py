@@ -452,7 +452,7 @@ class Segment:
         Segment([3.0, 0.0], [3.0, 1.0], velocity=[2.0, 0.0])
     """
 
-    __slots__ = ("p0", "p1", "velocity")
+    __slots__ = ("_before", "p0", "p1", "velocity")
 
     def __init__(self, p0, p1, velocity=(0.0, 0.0)):
         a = _real_array("segment p0", p0)
@@ -468,6 +468,7 @@ class Segment:
         self.p0 = _readonly(a)
         self.p1 = _readonly(b)
         self.velocity = _readonly(v + 0.0)  # (-0.0 -> 0.0)
+        self._before: tuple[float, Segment] | None = None  # (time steered, the segment until then)
 
     @property
     def moving(self) -> bool:
@@ -475,11 +476,43 @@ class Segment:
         return bool(self.velocity.any())
 
     def at(self, time: float) -> Segment:
-        """The segment where it is at ``time`` (itself if it does not move)."""
+        """The segment where it is at ``time`` (itself if it does not move; before a :meth:`steered` time, where
+        it was then)."""
+        if self._before is not None and time < self._before[0]:
+            return self._before[1].at(time)
         if not self.moving:
             return self
         shift = self.velocity * float(time)
         return Segment(self.p0 + shift, self.p1 + shift, self.velocity)
+
+    def steered(self, time: float, velocity) -> Segment:
+        """This segment from ``time`` on at ``velocity`` ``(2,)``, from where it is then; before ``time``, :meth:`at`
+        still gives where this one was (a paddle the player steers, drawn where it was at every time).
+
+        Example:
+            >>> paddle = Segment((0, 0), (0, 1)).steered(2.0, (1.0, 0.0))
+            >>> paddle.at(1.0).p0.tolist(), paddle.at(3.0).p0.tolist()
+            ([0.0, 0.0], [1.0, 0.0])
+        """
+        v = _real_array("segment velocity", velocity)
+        if v.shape != (2,) or not np.isfinite(v).all():
+            msg = f"segment velocity must be 2 finite numbers, got {v.tolist()}"
+            raise InvalidDiscsError(msg)
+        here, time = self.at(time), float(time)
+        moved = Segment(here.p0 - v * time, here.p1 - v * time, v)  # where it is at ``time``, at time ``time``
+        moved._before = (time, self)
+        return moved
+
+    def pieces(self) -> list[tuple[float, Segment]]:
+        """``[(until, segment), ...]``: the motions this segment had before each :meth:`steered` time, earliest
+        first (each ``segment`` without history: where it was is ``segment.at(t)`` for ``t < until``); ``[]`` if
+        it was never steered."""
+        out, seg = [], self
+        while seg._before is not None:
+            until, seg = seg._before
+            plain = Segment(seg.p0, seg.p1, seg.velocity)
+            out.append((until, plain))
+        return out[::-1]
 
     @property
     def length(self) -> float:

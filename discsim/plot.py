@@ -608,7 +608,7 @@ def animate(
                 outlines += _contact_outlines(ax, truth, colours, "-" if truth is s else "--")
         segments = tuple(getattr(s, "segments", ()))
         walls = draw_segments(ax, segments, float(times[0]))
-        moving = walls if any(segment.moving for segment in segments) else None  # moved at each frame
+        moving = walls if any(s.moving or s.pieces() for s in segments) else None  # moved (or steered): each frame
         dynamic += [] if moving is None else [moving]
         _setup(ax, s.box, getattr(s, "sensors", ()))
         pistons.append(piston_mover(ax, s, times, dynamic))  # where the piston is at each frame (none: no-op)

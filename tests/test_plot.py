@@ -349,6 +349,16 @@ def test_animate_draws_a_moving_segment_where_it_is_at_each_frame(tmp_path):
     plot.close(anim)
 
 
+def test_animate_draws_a_steered_segment_where_it_was_at_each_frame():
+    # Fixed at x = 8 until t = 1, then at -1 along x: at 0.5 still at 8, at 3 at 6.
+    paddle = ds.Segment((8.0, 3.0), (8.0, 7.0))
+    sim = ds.EventDriven(ds.Discs([[2.0, 5.0]], [[0.5, 0.0]], radii=0.4), ds.Box(10.0, 10.0), segments=[paddle])
+    sim.run(until=1.0).set_segment_velocity(0, (-1.0, 0.0)).run(until=3.0)
+    anim = plot.animate(sim, times=[0.5, 3.0])  # the figure shows the first frame
+    assert drawn_segments(anim._fig.axes[0]) == [[[8.0, 3.0], [8.0, 7.0]]]
+    plot.close(anim)
+
+
 def test_the_still_plots_draw_a_moving_segment_where_it_is_at_their_time():
     sim = paddle_run()
     assert drawn_segments(plot.plot_state(sim)) == [PADDLE_AT[4.0], FLOOR]

@@ -665,6 +665,19 @@ def test_the_page_draws_a_moving_segment_where_it_is_at_each_time(tmp_path):
         assert floor == [*FLOOR[0], *FLOOR[1]]  # a fixed segment stays put
 
 
+def test_the_page_draws_a_steered_segment_where_it_was_at_each_time(tmp_path):
+    sim = paddle_run().run(until=1.0)  # the paddle x = 8 - t until 1, then stopped at 7
+    sim.set_segment_velocity(0, (0.0, 0.0)).run(until=3.0)
+    page = ds.view(sim, tmp_path / "steered.html")
+    times = [0.5, 2.0]
+    script = (
+        "const out = []; for (const t of TIMES) { discsim.seek(t); out.push(discsim.segments(0)); }"
+        "document.getElementById('ds-readout').textContent = JSON.stringify(out);"
+    ).replace("TIMES", json.dumps(times))
+    drawn = drive(page.path, tmp_path, script)
+    assert [paddle for paddle, _ in drawn] == [[7.5, 3.0, 7.5, 7.0], [7.0, 3.0, 7.0, 7.0]]
+
+
 def piston_gas():
     """A small gas under a piston, and the piston's height sampled (run stopped) at some times."""
     discs, _ = ds.random_gas(8, 0.15, seed=2, periodic=False)

@@ -52,6 +52,7 @@
   const runs = DATA.runs.map((r) => {
     const run = {
       label: r.label, engine: r.engine, dt: r.dt, truth: r.truth, n: r.n, box: r.box, segments: r.segments,
+      segmentPast: r.segment_past || [],
       radii: decode(r.radii, Float64Array), fixed: decode(r.fixed, Uint8Array),
       groups: decode(r.groups, Int32Array), starts: decode(r.starts, Int32Array),
       times: decode(r.times, Float64Array), states: decode(r.states, Float64Array),
@@ -146,9 +147,12 @@
   }
 
   // Each segment's end points at time t into run.drawnSegments ([x0, y0, x1, y1]): a moving one (a row of six:
-  // p0, p1, velocity) at p0 + v t, p1 + v t (Segment.at's arithmetic); a fixed one (four) where it is.
+  // p0, p1, velocity) at p0 + v t, p1 + v t (Segment.at's arithmetic); a fixed one (four) where it is. Before a
+  // steer (sim.set_segment_velocity), the motion it had then: run.segmentPast[k], rows [until, p0, p1, velocity].
   function placeSegments(run, t) {
-    run.drawnSegments = run.segments.map((s) => {
+    run.drawnSegments = run.segments.map((row, k) => {
+      const past = (run.segmentPast[k] || []).find((p) => t < p[0]);
+      const s = past ? past.slice(1) : row;
       if (s.length < 6) return s.slice(0, 4);
       const sx = s[4] * t, sy = s[5] * t;
       return [s[0] + sx, s[1] + sy, s[2] + sx, s[3] + sy];

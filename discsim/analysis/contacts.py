@@ -184,14 +184,15 @@ def contacts_of(events, velocities, masses, radii, box, segments=()) -> Contacts
         p, r = ri[walls], radii[i[walls]]
         gaps = [p[:, 0] - r, box.width - r - p[:, 0], p[:, 1] - r, box.height - r - p[:, 1]]
         when = ev["time"][walls][:, None]
-        gaps += [seg.distance(p - seg.velocity * when) - r for seg in segments]  # (a moving one where it was then)
+        motions = [_segment_then(seg, p, when[:, 0]) for seg in segments]  # (a moving one where it was then)
+        gaps += [distance - r for distance, _ in motions]
         nearest = np.argmin(np.abs(np.column_stack(gaps)), axis=1)
         surface[walls] = np.where(nearest < 4, -1 - nearest, nearest - 4)
         kind[walls] = np.where(nearest < 4, "wall", "segment")
-        for s, seg in enumerate(segments):  # a moving segment's speed of approach is in its frame
+        for s, (_, velocity) in enumerate(motions):  # a moving segment's speed of approach is in its frame
             hit = nearest == 4 + s
-            if seg.moving and hit.any():
-                speed[walls[hit]] -= nrm[hit] @ seg.velocity
+            if hit.any():
+                speed[walls[hit]] -= np.einsum("ij,ij->i", nrm[hit], velocity[hit])
         piston = walls[np.isfinite(ev["yj"][walls])]  # a piston's impact (its height and velocity after in yj, vyj)
         surface[piston], kind[piston] = TOP, "wall"
         speed[piston] = ev["vyj"][piston] - ev["vyi"][piston]  # (elastic: approached as fast as they part)
@@ -236,11 +237,12 @@ def contact_of_record(rec, i: int, j: int, before_i, before_j, masses, radii, bo
         impulse = mi * size
         speed = vxi0 * nx + vyi0 * ny
         gaps = [xi - ri, box.width - ri - xi, yi - ri, box.height - ri - yi]
-        gaps += [float(seg.distance(np.array([[xi, yi]]) - seg.velocity * t)[0]) - ri for seg in segments]
+        then = [seg.at(t) for seg in segments]  # (a moving one where it was then, as it moved then)
+        gaps += [float(seg.distance(np.array([[xi, yi]]))[0]) - ri for seg in then]
         nearest = min(range(len(gaps)), key=lambda k: abs(gaps[k]))
         kind, surface = ("wall", -1 - nearest) if nearest < 4 else ("segment", nearest - 4)
-        if nearest >= 4 and segments[nearest - 4].moving:  # its speed of approach in the segment's frame
-            u = segments[nearest - 4].velocity
+        if nearest >= 4:  # its speed of approach in the segment's frame
+            u = then[nearest - 4].velocity
             speed -= nx * float(u[0]) + ny * float(u[1])
         if math.isfinite(float(rec["yj"])):  # a piston's impact (its height and velocity after in yj, vyj)
             kind, surface, speed = "wall", TOP, float(rec["vyj"]) - vyi  # (elastic: approached as fast as they part)
@@ -248,3 +250,16 @@ def contact_of_record(rec, i: int, j: int, before_i, before_j, masses, radii, bo
     if box.periodic:
         px, py = (float(v) for v in box.wrap(np.array([px, py])))
     return Contact(t, kind, i, j, np.array([px, py]), np.array([nx, ny]), impulse, speed, surface)
+
+
+def _segment_then(segment, points: np.ndarray, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(distances (K,), velocities (K, 2))``: from each of ``points`` ``(K, 2)`` to ``segment`` where it was at
+    each of ``times`` ``(K,)``, and its velocity then (the motion in force then, for one :meth:`Segment.steered`)."""
+    distances, velocities = np.empty(len(points)), np.empty((len(points), 2))
+    start = -np.inf
+    for until, piece in [*segment.pieces(), (np.inf, segment)]:
+        now = (times > start) & (times <= until)  # (a hit at the instant of a steer: the motion it steered)
+        distances[now] = piece.distance(points[now] - piece.velocity * times[now, None])
+        velocities[now] = piece.velocity
+        start = until
+    return distances, velocities

@@ -17,7 +17,7 @@ import numpy as np
 from discsim.cells import neighbour_pair_chunks
 from discsim.engines.context import LookOnly, RunContext, readonly_ids
 from discsim.errors import DiscsimError, InvalidArgumentError, OutsideBoxError, OverlapError, UnitsError, WrongTypeError
-from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, Segment, _real_array
+from discsim.model import OVERLAP_TOLERANCE, SPEED_RANGE, Box, Discs, _real_array
 from discsim.scene import Scene, check_added
 
 __all__ = ["DiscEditing", "Uneditable"]
@@ -57,8 +57,7 @@ class SegmentEditing:
         if v.shape != (2,) or not np.isfinite(v).all():
             msg = f"segment {k}'s velocity must be 2 finite numbers, got {v.tolist()}"
             raise InvalidArgumentError(msg)
-        here = self.segments[int(k)].at(self.time)
-        moved = Segment(here.p0 - v * self.time, here.p1 - v * self.time, v)  # where it is now, at time now
+        moved = self.segments[int(k)].steered(self.time, v)  # where it is now, at time now (drawn where it was)
         self._moved_segments((*self.segments[:k], moved, *self.segments[k + 1 :]))
         self._edits += 1
         return self

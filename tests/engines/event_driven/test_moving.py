@@ -159,6 +159,30 @@ def test_a_paddle_steered_mid_run_stays_where_it_is_and_moves_on_at_its_new_velo
     assert sim.segments[0].at(6.0).p0 == pytest.approx([8.0 - 2.0 * (4.75 - 2.0), 3.0])  # where it stopped
     sim.save(tmp_path / "steered.npz")
     assert ds.load(tmp_path / "steered.npz").segments[0].velocity.tolist() == [0.0, 0.0]
+    # Where it was at every time (drawn there by plots and the viewer): fixed, then sweeping, then stopped.
+    steered = sim.segments[0]
+    assert [float(steered.at(t).p0[0]) for t in (1.0, 2.0, 3.0, 6.0)] == pytest.approx([8.0, 8.0, 6.0, 2.5])
+    assert [(until, piece.velocity.tolist()) for until, piece in steered.pieces()] == [
+        (2.0, [0.0, 0.0]),
+        (pytest.approx(4.75), [-2.0, 0.0]),
+    ]
+    # The contact at 4.75 came while it swept at 2 onto the disc at rest: the speed of approach in its frame is 2
+    # (not 0, as the motion it has now would say).
+    first, *later = [c for c in ds.contacts(sim) if c.kind == "segment"]
+    assert first.time == pytest.approx(4.75) and first.speed == pytest.approx(2.0, rel=1e-12)
+    assert later and all(c.speed == pytest.approx(4.0, rel=1e-12) for c in later)  # it came back at 4: stopped
+
+
+def test_a_steered_segment_remembers_its_motions():
+    s = ds.Segment((0.0, 0.0), (0.0, 1.0))
+    moved = s.steered(2.0, (1.0, 0.0)).steered(4.0, (0.0, -0.5))
+    assert [moved.at(t).p0.tolist() for t in (0.0, 2.0, 3.0, 4.0, 6.0)] == [
+        [0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, -1.0]
+    ]  # fmt: skip
+    assert moved.moving and repr(moved) == "Segment([2.0, 2.0], [2.0, 3.0], velocity=[0.0, -0.5])"
+    assert [until for until, _ in moved.pieces()] == [2.0, 4.0] and s.pieces() == []
+    with pytest.raises(ds.DiscsimError, match="velocity must be 2 finite numbers"):
+        s.steered(1.0, (math.nan, 0.0))
 
 
 def test_steering_a_segment_is_refused_by_name_and_changes_nothing():

@@ -402,7 +402,7 @@ def _turning_records(history: tuple, starts: np.ndarray, times: np.ndarray) -> n
 
 
 def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict:
-    from discsim.io.streams import segment_rows
+    from discsim.io.streams import segment_past_rows, segment_rows
 
     starts, times, states, partners, kinds = _records(span, t0)
     discs = _discs_of(span)
@@ -428,7 +428,7 @@ def _run_data(run: _Run, span: _Span, t0: float, t1: float, truth: bool) -> dict
         "n": len(discs),
         "box": {"width": float(box.width), "height": float(box.height), "periodic": bool(box.periodic)},
         "segments": segment_rows(run.segments),  # as checkpoints store them: [p0, p1] or [p0, p1, velocity]
-        "segment_past": [_past_rows(segment) for segment in run.segments],  # a steered one's earlier motions
+        "segment_past": [segment_past_rows(segment) for segment in run.segments],  # a steered one's earlier motions
         "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in run.sensors],  # as checkpoints store them
         "enter_times": _b64(entries["time"], "<f8"),
         "enter_sensors": _b64(entries["j"], "<i4"),
@@ -696,11 +696,3 @@ def _page(data: dict) -> str:
         f'<script type="application/json" id="ds-data">{payload}</script>\n'
         f"<script>\n{script}</script>\n</body>\n</html>\n"
     )
-
-
-def _past_rows(segment) -> list[list[float]]:
-    """Rows ``[until, p0x, p0y, p1x, p1y, vx, vy]``: the motions a steered segment had before each steer, earliest
-    first (:meth:`~discsim.model.Segment.pieces`; end points at time 0 as the segment rows hold them)."""
-    return [
-        [until, *piece.p0.tolist(), *piece.p1.tolist(), *piece.velocity.tolist()] for until, piece in segment.pieces()
-    ]

@@ -27,6 +27,7 @@ __all__ = [
     "StreamedEvents",
     "iter_events",
     "read_events",
+    "segment_past_rows",
     "segment_rows",
     "segments_from_rows",
     "sensors_from_rows",
@@ -257,6 +258,14 @@ def segment_rows(segments) -> list[list[float]]:
         [[0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 1.0, 1.0, 0.0, -0.5]]
     """
     return [[*s.p0.tolist(), *s.p1.tolist(), *(s.velocity.tolist() if s.moving else [])] for s in segments]
+
+
+def segment_past_rows(segment: Segment) -> list[list[float]]:
+    """Rows ``[until, p0x, p0y, p1x, p1y, vx, vy]``: the motions a steered segment had before each steer, earliest
+    first (:meth:`~discsim.model.Segment.pieces`; end points at time 0, as :func:`segment_rows` holds them)."""
+    return [
+        [until, *piece.p0.tolist(), *piece.p1.tolist(), *piece.velocity.tolist()] for until, piece in segment.pieces()
+    ]
 
 
 def segments_from_rows(rows, where) -> tuple[Segment, ...]:

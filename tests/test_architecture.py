@@ -14,6 +14,7 @@ FLOORS = {
         "model",
         "sensors",
         "piston",
+        "polygons",
         "queue",
         "errors",
         "_validate",

@@ -108,8 +108,7 @@ class RunStops:
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None
-        if self._kinematic:
-            self._speed_reference()  # (before the walls squeeze anything: at the first run after an edit)
+        self._speed_reference()  # (before the walls squeeze anything: at the first run after an edit)
         try:
             if until != INF:
                 return self._chunked(until, limit, log)
@@ -233,7 +232,7 @@ class RunStops:
                 self._jammed(mark, units, chunk)
             elif units - mark[1] >= half and self._jam_counts is None:
                 self._jam_counts = (units, backend.disc_counts())
-            if self._kinematic and not 0 <= units - self._squeeze_units < half:
+            if not 0 <= units - self._squeeze_units < half and self._kinematic:
                 self._squeeze_units = units
                 self._check_squeeze(until)
             if k < ask or done == limit:
@@ -279,7 +278,8 @@ class RunStops:
     #: :func:`~discsim.engines.event_driven.squeeze.squeeze` cannot prove (several discs squeezed together; drag,
     #: roughness, a periodic box), whose speeds grow with every bounce (by about the walls' speed each).
     squeeze_speedup: float = 1e4
-    _speed_scale: tuple[int, float] | None = None  # (edits, speed scale) when taken
+    _speed_scale: tuple[tuple[int, float], float] | None = None  # ((edits, piston change), speed scale) when taken
+    _piston_since: float
 
     def _check_speedup(self, velocities: np.ndarray) -> None:
         """The backstop of :meth:`_check_squeeze`: raise on a disc faster than ``squeeze_speedup`` times the speed
@@ -300,10 +300,14 @@ class RunStops:
             raise JammedError(msg)
 
     def _speed_reference(self) -> float:
-        """The speed scale of :meth:`_check_speedup`, taken at the first run after each edit (O(N), kept)."""
-        kept = self._speed_scale
-        if kept is not None and kept[0] == self._edits:
+        """The speed scale of :meth:`_check_speedup`, taken at the first run after each edit of the discs or the
+        piston (O(N) with kinematic walls, else 0.0; kept)."""
+        kept, key = self._speed_scale, (self._edits, self._piston_since)
+        if kept is not None and kept[0] == key:
             return kept[1]
+        if not self._kinematic:
+            self._speed_scale = (key, 0.0)
+            return 0.0
         masses, velocities = self.discs.masses, self.velocities
         finite = np.isfinite(masses)
         energy = 0.0
@@ -315,7 +319,7 @@ class RunStops:
         if piston is not None and piston.kinematic:
             walls.append(abs(self._piston_now()[1]))
         scale = max(math.sqrt(energy + fall), *walls)
-        self._speed_scale = (self._edits, scale)
+        self._speed_scale = (key, scale)
         return scale
 
     def _crush_message(self, crush: Crush, steer: str) -> str:

@@ -114,15 +114,18 @@ def plot(rows: list[dict], path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    for sides in sorted({r["sides"] for r in rows}):
+    for k, sides in enumerate(sorted({r["sides"] for r in rows})):
         mine = [r for r in rows if r["sides"] == sides]
         turns = [r["turn"] for r in mine]
-        ax.plot(turns, [r["pit_missed"] for r in mine], "o-", label=f"PIT missed, {sides}-gons")
-        ax.plot(turns, [r["swept_alarms"] for r in mine], "s--", label=f"swept false alarms, {sides}-gons")
+        colour = f"C{k}"
+        ax.plot(turns, [r["pit_missed"] for r in mine], "o-", color=colour, label=f"PIT missed, {sides}-gons")
+        ax.plot(
+            turns, [r["swept_alarms"] for r in mine], "s--", color=colour, label=f"swept false alarms, {sides}-gons"
+        )
     ax.set_xlabel("turn per frame (rad)")
     ax.set_ylabel("share of pairs")
     ax.set_xscale("log")
-    ax.set_title("Two spinning polygons: what PIT misses, what swept volumes flag early")
+    ax.set_title("Spinning polygons: PIT's misses, swept volumes' false alarms", fontsize=10)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

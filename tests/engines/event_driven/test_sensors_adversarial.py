@@ -83,6 +83,26 @@ def test_every_wrap_across_a_trip_wire_on_a_periodic_edge_is_reported_once_at_it
     assert {(i, j) for _, _, i, j in found} == {(0, 0)}
 
 
+@pytest.mark.parametrize("laws", [{"gravity": (0.0, -0.1)}, {"drag": 0.05}])
+def test_a_trip_wire_on_a_periodic_edge_under_gravity_or_drag_is_crossed_at_each_wrap(laws):
+    # Gravity along y leaves x's flight straight: wraps at (10 - 3.3) / 1.7 + 10 k / 1.7. Drag slows it: the k-th
+    # wrap is where x has gone 6.7 + 10 k, x(t) = 3.3 + 1.7 (1 - exp(-0.05 t)) / 0.05. The wires on x = 0 and x = 10
+    # are one: the same log.
+    logs = []
+    for x in (0.0, 10.0):
+        sim = ds.EventDriven(ds.Discs([[3.3, 8.0]], [[1.7, 0.3]], radii=0.2), ds.Box(10.0, 10.0, periodic=True),
+                             sensors=[Sensor.line((x, 0.0), (x, 10.0))], **laws)  # fmt: skip
+        sim.run(until=20.0)
+        logs.append(crossings(sim))
+    assert logs[0] == logs[1]
+    if "drag" in laws:
+        expected = [-np.log(1.0 - 0.05 * d / 1.7) / 0.05 for d in (6.7, 16.7)]
+    else:
+        expected = [(6.7 + 10.0 * k) / 1.7 for k in range(3)]
+    assert [t for t, *_ in logs[0]] == pytest.approx(expected, rel=1e-12)
+    assert [k for _, k, *_ in logs[0]] == ["leave"] * len(expected)
+
+
 @pytest.mark.parametrize("vx", [0.7310, -0.7310])
 def test_a_trip_wire_along_part_of_a_periodic_edge_reports_the_wraps_across_that_part_only(vx):
     # The wire (0, 2) to (0, 5) covers part of the left edge (the right edge too); the disc climbs 0.9 a lap, so it

@@ -12,6 +12,10 @@ What "inside" means, the one definition every engine uses (:meth:`Sensor.contain
   (``cross(p1 - p0, p - p0) > 0``). A disc *enters* a line when its centre crosses the segment from its right
   to its left, and *leaves* it when it crosses back; passing beyond an end of the segment reports nothing.
 
+In a periodic box the edges x = 0 and x = W are one line (so are y = 0 and y = H): a line along an edge
+(:func:`edge_axis`) is crossed each time a centre wraps across that edge at a point of the line, and a centre's side
+of it is the side of the box's inside (:func:`inside_table`).
+
 Example:
     >>> pocket = Sensor.circle((0.0, 0.0), 1.0)
     >>> pocket.contains([[0.5, 0.0], [2.0, 0.0]]).tolist()
@@ -27,7 +31,17 @@ import numpy as np
 from discsim.errors import InvalidArgumentError
 from discsim.model import _readonly, _real_array
 
-__all__ = ["CIRCLE", "LINE", "RECTANGLE", "Sensor", "check_sensors", "inside_table", "sensor_rows"]
+__all__ = [
+    "CIRCLE",
+    "LINE",
+    "RECTANGLE",
+    "Sensor",
+    "check_sensors",
+    "edge_axis",
+    "inside_table",
+    "on_periodic_edge",
+    "sensor_rows",
+]
 
 #: The shape codes of :func:`sensor_rows` (what the compiled loop reads).
 CIRCLE, RECTANGLE, LINE = 1, 2, 3
@@ -189,10 +203,43 @@ def sensor_rows(sensors) -> np.ndarray:
     return rows
 
 
-def inside_table(sensors, positions) -> np.ndarray:
-    """``(N, S)`` int64: 1 where each of ``positions`` ``(N, 2)`` is inside each sensor (:meth:`Sensor.contains`)."""
+def edge_axis(code: float, a0: float, a1: float, a2: float, a3: float, width: float, height: float) -> int:
+    """0 if a sensor (``code`` its shape code, ``a0 .. a3`` its :attr:`Sensor.params`) is a trip wire along a box's
+    edge x = 0 or x = ``width``, 1 along y = 0 or y = ``height``, else -1 (plain floats: the compiled loop's too).
+
+    In a periodic box the edges x = 0 and x = ``width`` are one line (so are y = 0 and y = ``height``): a centre
+    crosses such a wire only by jumping across the box's edge, and its side of the wire is the side of the box's
+    inside wherever it is (on the edge too).
+
+    Example:
+        >>> edge_axis(LINE, 0.0, 2.0, 0.0, 5.0, 10.0, 10.0), edge_axis(LINE, 1.0, 2.0, 1.0, 5.0, 10.0, 10.0)
+        (0, -1)
+    """
+    if code != LINE:
+        return -1
+    if a0 == a2 and (a0 == 0.0 or a0 == width):
+        return 0
+    if a1 == a3 and (a1 == 0.0 or a1 == height):
+        return 1
+    return -1
+
+
+def on_periodic_edge(sensor: Sensor, box) -> bool:
+    """Whether ``sensor`` is a trip wire along the edge of ``box`` (a :class:`~discsim.model.Box`), a periodic one
+    (:func:`edge_axis`)."""
+    a0, a1, a2, a3 = sensor.params.tolist()
+    return bool(box.periodic) and edge_axis(sensor.code, a0, a1, a2, a3, box.width, box.height) >= 0
+
+
+def inside_table(sensors, positions, box=None) -> np.ndarray:
+    """``(N, S)`` int64: 1 where each of ``positions`` ``(N, 2)`` is inside each sensor (:meth:`Sensor.contains`);
+    in a periodic ``box`` (a :class:`~discsim.model.Box`), a trip wire along its edge (:func:`edge_axis`) takes the
+    side of the box's inside."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
     table = np.zeros((len(positions), len(sensors)), dtype=np.int64)
     for k, sensor in enumerate(sensors):
-        table[:, k] = sensor.contains(positions) if len(positions) else 0
+        if box is not None and on_periodic_edge(sensor, box):
+            table[:, k] = sensor.contains([0.5 * box.width, 0.5 * box.height])[0]
+        else:
+            table[:, k] = sensor.contains(positions) if len(positions) else 0
     return table

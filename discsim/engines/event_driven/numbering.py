@@ -102,6 +102,6 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
         last_collision=np.full(n, -math.inf),
         spins=np.array(discs.spins),
         angles=np.zeros(n),
-        sensed=inside_table(scene.sensors, discs.positions),
+        sensed=inside_table(scene.sensors, discs.positions, scene.box),
         piston=piston,
     )

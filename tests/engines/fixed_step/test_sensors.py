@@ -144,6 +144,32 @@ def test_a_line_in_a_periodic_box_is_crossed_once_per_image_reached():
     assert rows(sim) == [(0.25, LEAVE, 0, 0), (0.25, LEAVE, 0, 0)]
 
 
+@pytest.mark.parametrize(
+    ("p0", "p1", "axis"),
+    [
+        ((0.0, 0.0), (0.0, 10.0), 0),
+        ((10.0, 0.0), (10.0, 10.0), 0),  # the same wire: the box's edges x = 0 and x = 10 are one line
+        ((0.0, 10.0), (10.0, 10.0), 1),
+        ((0.0, 0.0), (0.0, 4.0), 0),  # along part of the edge: the second wrap passes beyond its end (y > 4)
+    ],
+)
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_trip_wire_on_a_periodic_edge_is_crossed_at_each_wrap_over_it(p0, p1, axis, sign):
+    # The centre from 3.3 at speed 0.731 along the axis (0.09 across it) reaches the edge at 9.166 and 22.846
+    # (+) or 4.514 and 18.194 (-), at 3.82 and 5.05 across (+) or 3.41 and 4.64 (-), and jumps to the other edge.
+    velocity, start = [0.09, 0.09], [3.0, 3.0]
+    velocity[axis], start[axis] = sign * 0.731, 3.3
+    sim = ds.FixedStep(lone(*start, *velocity), ds.Box(10.0, 10.0, periodic=True), dt=DT,
+                       sensors=[Sensor.line(p0, p1)])  # fmt: skip
+    sim.run(until=25.0)
+    first = (10.0 - 3.3) / 0.731 if sign > 0 else 3.3 / 0.731
+    times = [first, first + 10.0 / 0.731]
+    over = [t for t in times if p1[1] != 4.0 or 3.0 + 0.09 * t <= 4.0]
+    turning = (p1[0] - p0[0]) * velocity[1] - (p1[1] - p0[1]) * velocity[0]
+    kind = ENTER if turning > 0.0 else LEAVE
+    assert rows(sim) == [(first_frame_after(t), kind, 0, 0) for t in over]
+
+
 # --- what it misses (docs/study.md) -------------------------------------------------------------------------------
 
 

@@ -23,7 +23,7 @@ from discsim.events import EVENT_DTYPE, SENSED, SPIN_DTYPE, EventKind, EventLog
 from discsim.laws import Laws
 from discsim.physics import dynamics
 from discsim.scene import Scene
-from discsim.sensors import inside_table, sensor_rows
+from discsim.sensors import inside_table, on_periodic_edge, sensor_rows
 
 __all__ = ["NumbaBackend"]
 
@@ -248,7 +248,7 @@ class NumbaBackend(CompiledReads):
         sensed, sensors = state.sensed, self.scene.sensors
         if sensed.shape != (n, len(sensors)):  # not kept (no sensor before): where the discs are now
             gravity = self.laws.gravity if self.laws.falls else None
-            sensed = inside_table(sensors, state.positions_at(state.time, gravity, drag=self.laws.drag))
+            sensed = inside_table(sensors, state.positions_at(state.time, gravity, drag=self.laws.drag), self.box)
         self._rest = np.concatenate([state.resting[order], sensed[order].ravel()]).astype(np.int8)
         seg = self._seg  # a moving segment's row: where it is at the epoch (as rebase puts it)
         moving = (seg[:, 6] != 0.0) | (seg[:, 7] != 0.0)
@@ -417,7 +417,7 @@ class NumbaBackend(CompiledReads):
             cell = int(self.grid.cells_of(np.array([[x, y]]))[0])
         if moved and self.scene.sensors:  # its sides are where it is now (put back, a centre on an edge keeps its own)
             sensors, n = self.scene.sensors, len(rec)
-            self._rest[n + k * len(sensors) : n + (k + 1) * len(sensors)] = inside_table(sensors, [[x, y]])[0]
+            self._rest[n + k * len(sensors) : n + (k + 1) * len(sensors)] = inside_table(sensors, [[x, y]], self.box)[0]
         held: list[int] = []
         if self.laws.falls and self._rest[k] != 0:  # a support at rest moves: what it held up falls again
             gx, gy = self.laws.gravity
@@ -469,8 +469,11 @@ _NO_EVENTS = (
 
 def _sensor_cells(grid: CellGrid, sensor) -> list[int]:
     """The cells a disc's centre may cross ``sensor``'s edge from: over its bounds (a hair wider, for a centre on a
-    cell's edge), or every cell for a trip wire (its side changes wherever the line runs, beyond the wire too)."""
+    cell's edge), or every cell for a trip wire (its side changes wherever the line runs, beyond the wire too), but
+    none for a trip wire along a periodic box's edge: crossed only by the jumps across it (``sensing.wrap_sense``)."""
     if sensor.shape == "line":
+        if on_periodic_edge(sensor, grid.box):
+            return []
         return list(range(len(grid)))
     x0, y0, x1, y1 = sensor.bounds()
     hair = 1e-9 * max(grid.box.width, grid.box.height)

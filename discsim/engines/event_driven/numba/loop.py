@@ -36,7 +36,7 @@ from discsim._compiled import inline, jit
 from discsim.engines.event_driven.numba import blocks, moving
 from discsim.engines.event_driven.numba.blocks import BLOCK, BLOCK_SHIFT, discard, push, reblock  # noqa: F401
 from discsim.engines.event_driven.numba.cells import _enter, _leave, link, unlink  # noqa: F401
-from discsim.engines.event_driven.numba.sensing import resense, sense
+from discsim.engines.event_driven.numba.sensing import resense, sense, wrap_sense
 from discsim.engines.event_driven.numba.support import (  # noqa: F401
     ANGLE,
     ANGLE_T,
@@ -350,8 +350,7 @@ def run_events(
     epoch = floats[F_EPOCH]
     horizon = until - epoch
     rebase_at = rebase_every - ints[I_SINCE]
-    now = np.nan
-    have_now = False
+    now, have_now = np.nan, False
     last_time, last_kind, last_i, last_j = floats[F_LTIME], ints[I_LKIND], ints[I_LI], ints[I_LJ]
     while done != limit:
         if pops == budget or (recording and logged + room > capacity):
@@ -620,32 +619,37 @@ def run_events(
             )  # fmt: skip
         else:  # cell crossing: the trajectory is unchanged, only the neighbourhood
             c = cell[i]
-            _leave(i, c, head, nxt)
             cx, cy, wrap_x, wrap_y = cross(c // ny, c - (c // ny) * ny, other, nx, ny)
-            if wrap_x != 0:  # out through one edge of the box, in through the other
-                rec[i, X] = rec[i, X] - wrap_x * width
-                images[i, 0] += wrap_x
-            elif wrap_y != 0:
-                rec[i, Y] = rec[i, Y] - wrap_y * height
-                images[i, 1] += wrap_y
-            if LAWS and (wrap_x != 0 or wrap_y != 0) and rest.shape[0] > rec.shape[0]:
-                # Across the periodic box's edge: the sides of trip wires may differ here (regions lie inside)
-                resense(i, t, gravity, gx, gy, drag, rec, rest, seg)
-            c = cx * ny + cy
-            cell[i] = c
-            _enter(i, c, head, nxt)
-            n_cross += 1
-            predict(
-                i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
-                nx, ny, periodic, edges,
-                seg, seg_start, seg_idx, group, blocked, rest,
-                qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
-            )  # fmt: skip
-            if n_cross == crossings:
-                now = t
-                have_now = True
-                why = CROSSINGS
-                break
+            sensed = s = -1
+            if LAWS and (wrap_x != 0 or wrap_y != 0) and rest.shape[0] > rec.shape[0]:  # sensors it crosses there
+                sensed, s = wrap_sense(
+                    i, t, epoch, wrap_x, wrap_y, width, height, gravity, gx, gy, drag, rough, recording, logged, rec,
+                    rest, seg, order, rot, ev_t, ev_kind, ev_i, ev_j, ev_f, ev_w,
+                )  # fmt: skip
+            if sensed >= 0:  # one an event (sensing.py): the jump waits, pushed again
+                n_sense, done, logged = n_sense + 1, done + 1, logged + (1 if recording else 0)
+                last_time, last_kind, last_i, last_j = t + epoch, sensed, i, s
+                push(i, t, CROSSING, other, 0, qt, bheap, bht, bpos, barg, qk, qo, qs, ints)
+            else:
+                _leave(i, c, head, nxt)
+                if wrap_x != 0:  # out through one edge of the box, in through the other
+                    rec[i, X], images[i, 0] = rec[i, X] - wrap_x * width, images[i, 0] + wrap_x
+                elif wrap_y != 0:
+                    rec[i, Y], images[i, 1] = rec[i, Y] - wrap_y * height, images[i, 1] + wrap_y
+                if LAWS and (wrap_x != 0 or wrap_y != 0) and rest.shape[0] > rec.shape[0]:  # the sides here
+                    resense(i, t, gravity, gx, gy, drag, rec, rest, seg, width, height)
+                c = cell[i] = cx * ny + cy
+                _enter(i, c, head, nxt)
+                n_cross += 1
+                predict(
+                    i, t, -1, other, rec, count, kept_partner, kept_stamp, cell, head, nxt,
+                    nx, ny, periodic, edges,
+                    seg, seg_start, seg_idx, group, blocked, rest,
+                    qt, bheap, bht, bpos, barg, qk, qo, qs, ints,
+                )  # fmt: skip
+                if n_cross == crossings:
+                    now, have_now, why = t, True, CROSSINGS
+                    break
         if LAWS and woke >= 0:  # the discs at rest that the woken support held up fall again from here
             for m in range(supported(woke, gx, gy, rec, rest, cell, head, nxt, nx, ny, periodic, edges, found)):
                 d = found[m]
@@ -670,19 +674,15 @@ def run_events(
                 )  # fmt: skip
             if ints[I_SIZE] > max_queue:
                 max_queue = ints[I_SIZE]
-        now = t
-        have_now = True
+        now, have_now = t, True
         if done >= rebase_at:
             moving.rebase(now, epoch, rec, qt, bheap, bht, bpos, barg, seg, edges, nx + ny + 2 + LAW_SLOTS)
             floats[F_EPOCH] += now
             epoch = floats[F_EPOCH]
-            now = 0.0
-            horizon = until - epoch
-            rebase_at = done + rebase_every
+            now, horizon, rebase_at = 0.0, until - epoch, done + rebase_every
     ints[I_SINCE] = rebase_every - (rebase_at - done)
     ints[I_MAXQ] = max_queue
-    floats[F_VIRIAL] = virial
-    floats[F_OVERLAP] = max_overlap
+    floats[F_VIRIAL], floats[F_OVERLAP] = virial, max_overlap
     if have_now:
         floats[F_TIME] = now + epoch
     floats[F_LTIME] = last_time

@@ -170,7 +170,7 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
     """
     segments = check_segments(segments, box)
     for k, segment in enumerate(segments):
-        if not _crosses_box(segment, box):
+        if not _crosses_box(segment.at(0.0), box):  # (a steered one where it was: not its new motion run back)
             msg = f"segments[{k}] {segment!r} lies entirely outside the box {box.width:g} x {box.height:g}"
             raise InvalidArgumentError(msg)
     if len(discs):
@@ -188,7 +188,7 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
     if unknown:
         msg = f"pass_through names group label(s) {unknown} that no disc has (groups: {labels[:20]})"
         warnings.warn(msg, UserWarning, stacklevel=4)
-    check_fits(discs, box, segments=segments, pass_through=pass_through)
+    check_fits(discs, box, segments=[segment.at(0.0) for segment in segments], pass_through=pass_through)
     return segments, pass_through
 
 

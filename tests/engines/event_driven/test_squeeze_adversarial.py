@@ -46,3 +46,34 @@ def test_a_lid_a_callback_steers_up_half_way_to_the_crush_does_not_stop_a_busy_g
     sim.on("wall", lambda sim, _: sim.set_piston(velocity=1.0) if sim.time > turn and sim.piston.velocity < 0 else None)
     sim.run(until=2.0 * turn + 1.0, events=400_000)
     assert sim.time == 2.0 * turn + 1.0 and sim.piston.velocity == 1.0
+
+
+def row_squeeze():
+    """Three discs in a row at rest, y = 5, x = 1, 3, 5, and the paddle x = 8 - t pushing them into the wall x = 0:
+    no single disc is caught for certain (each has neighbours), so only the backstop can stop it before t = 5."""
+    paddle = ds.Segment((8.0, 4.0), (8.0, 6.0), velocity=(-1.0, 0.0))
+    discs = ds.Discs([[1.0, 5.0], [3.0, 5.0], [5.0, 5.0]], np.zeros((3, 2)), radii=0.5)
+    sim = ds.EventDriven(discs, ds.Box(10.0, 10.0), segments=[paddle])
+    sim.squeeze_speedup, sim.jam_events = 100.0, 1_000  # (the backstop sooner, looking every 650 events)
+    return sim
+
+
+def test_the_backstop_stops_a_row_of_discs_squeezed_by_a_paddle():
+    sim = row_squeeze()
+    with pytest.raises(JammedError, match="100 times the speed scale"):
+        sim.run(until=20.0, events=3_000)
+    assert sim.time < 5.0
+    sim._check()
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="each edit retakes the backstop's speed scale from the discs' present speeds: a callback that edits "
+    "anything at each contact (here it re-aims the paddle at the velocity it has) resets the scale to the speeds the "
+    "squeeze already pumped up, so the backstop never fires and run(until=20) creeps towards t = 5 for ever",
+)
+def test_the_backstop_stops_a_squeeze_whose_callback_steers_the_paddle_at_each_contact():
+    sim = row_squeeze()
+    sim.on("segment", lambda sim, _: sim.set_segment_velocity(0, (-1.0, 0.0)))  # (a paddle AI: the same velocity)
+    with pytest.raises(JammedError, match="100 times the speed scale"):
+        sim.run(until=20.0, events=3_000)  # (now: returns at the event limit, the fastest disc at ~700)

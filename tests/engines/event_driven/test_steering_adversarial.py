@@ -38,3 +38,30 @@ def test_a_checkpoint_of_a_steered_run_keeps_where_the_segment_was(tmp_path):
     assert np.array_equal(back.positions, sim.positions) and np.array_equal(back.velocities, sim.velocities)
     assert back.segments[0].at(8.0).p0.tolist() == sim.segments[0].at(8.0).p0.tolist()
     back._check()
+
+
+def test_a_new_run_refuses_a_steered_segment_it_would_move_elsewhere():
+    # The paddle fixed at x = 8 until t = 4 (then at -1): a new run moved it on its last motion from t = 0 (at x = 12
+    # then), so a ball from x = 5 met it at t = 3.25 at x = 8.75, where at(), the plots and contacts say there was no
+    # paddle (and the scene check looked at one place while the run used the other).
+    paddle = ds.Segment((8.0, 3.0), (8.0, 7.0)).steered(4.0, (-1.0, 0.0))
+    ball = ds.Discs([[5.0, 5.0]], [[1.0, 0.0]], radii=0.5)
+    for make in (
+        lambda: ds.EventDriven(ball, ds.Box(14.0, 10.0), segments=[ds.Segment((1, 1), (1, 2)), paddle]),
+        lambda: ds.FixedStep(ball, ds.Box(14.0, 10.0), segments=[ds.Segment((1, 1), (1, 2)), paddle], dt=0.01),
+    ):
+        with pytest.raises(ds.DiscsimError, match=r"segments\[1\] .* was steered at time 4\.0"):
+            make()
+    # As it moves from the start, it runs.
+    sim = ds.EventDriven(ball, ds.Box(14.0, 10.0), segments=[ds.Segment(paddle.p0, paddle.p1, paddle.velocity)])
+    assert sim.step().time == 3.25
+
+
+@pytest.mark.parametrize(("time", "why"), [(float("nan"), "nan"), (float("inf"), "inf"), (1.0, "1.0"), ("2", "'2'")])
+def test_steering_at_a_time_that_is_not_finite_or_before_the_last_steer_is_refused_by_name(time, why):
+    # NaN and inf gave "segment p0 must be 2 finite numbers, got [nan, nan]" (and a RuntimeWarning); a time before
+    # the last steer gave pieces() out of order.
+    paddle = ds.Segment((8.0, 3.0), (8.0, 7.0)).steered(2.0, (1.0, 0.0))
+    with pytest.raises(ds.DiscsimError, match=rf"steer time must be a finite number, not before .*2\.0.*got {why}"):
+        paddle.steered(time, (0.0, 1.0))
+    assert [until for until, _ in paddle.steered(2.0, (0.0, 1.0)).pieces()] == [2.0, 2.0]  # twice in one instant

@@ -2,6 +2,9 @@
 motions (``Segment.steered``, ``Segment.pieces``) through checkpoints, contacts and runs on. Every test runs on
 both backends (the directory's conftest)."""
 
+import json
+import re
+
 import numpy as np
 import pytest
 
@@ -38,6 +41,15 @@ def test_a_checkpoint_of_a_steered_run_keeps_where_the_segment_was(tmp_path):
     assert np.array_equal(back.positions, sim.positions) and np.array_equal(back.velocities, sim.velocities)
     assert back.segments[0].at(8.0).p0.tolist() == sim.segments[0].at(8.0).p0.tolist()
     back._check()
+
+
+def test_the_viewer_draws_a_steered_segment_of_a_checkpoint_where_it_was(tmp_path):
+    # ds.view of the file loads it: it was refused (the load's 'lies entirely outside the box').
+    steered_run().save(tmp_path / "steered.npz")
+    page = ds.view(tmp_path / "steered.npz", path=None)
+    found = re.search(r'<script type="application/json" id="ds-data">(.*?)</script>', page.html, re.S)
+    data = json.loads(found.group(1).replace("<\\/", "</"))
+    assert json.dumps(data).count("[[[4.0, 8.0, 3.0, 8.0, 7.0, 0.0, 0.0]]]") == 1  # its segment_past
 
 
 def test_a_new_run_refuses_a_steered_segment_it_would_move_elsewhere():

@@ -493,10 +493,18 @@ class Segment:
             >>> paddle = Segment((0, 0), (0, 1)).steered(2.0, (1.0, 0.0))
             >>> paddle.at(1.0).p0.tolist(), paddle.at(3.0).p0.tolist()
             ([0.0, 0.0], [1.0, 0.0])
+
+        Raises:
+            InvalidDiscsError: on a velocity that is not 2 finite numbers, or a ``time`` that is not finite or comes
+                before the segment's last steer.
         """
         v = _real_array("segment velocity", velocity)
         if v.shape != (2,) or not np.isfinite(v).all():
             msg = f"segment velocity must be 2 finite numbers, got {v.tolist()}"
+            raise InvalidDiscsError(msg)
+        last = -math.inf if self._before is None else self._before[0]
+        if not (isinstance(time, (int, float, np.integer, np.floating)) and last <= float(time) < math.inf):
+            msg = f"segment steer time must be a finite number, not before its last steer ({last!r}), got {time!r}"
             raise InvalidDiscsError(msg)
         here, time = self.at(time), float(time)
         moved = Segment(here.p0 - v * time, here.p1 - v * time, v)  # where it is at ``time``, at time ``time``

@@ -156,6 +156,26 @@ def check_segments(segments, box: Box) -> tuple[Segment, ...]:
     return segments
 
 
+def check_unsteered(segments) -> tuple:
+    """``segments`` as a tuple, for a new run: refused if one was steered (:meth:`~discsim.model.Segment.steered`,
+    ``set_segment_velocity``), since a new run would move it on its last motion from the start, not where it was.
+
+    Raises:
+        InvalidArgumentError: naming the first steered segment and when it was steered.
+    """
+    segments = tuple(segments)
+    for k, segment in enumerate(segments):
+        pieces = segment.pieces() if isinstance(segment, Segment) else []
+        if pieces:
+            msg = (
+                f"segments[{k}] {segment!r} was steered at time {pieces[-1][0]!r} (set_segment_velocity): a new run "
+                "would move it on its last motion from the start, not where it was; give ds.Segment(p0, p1, "
+                "velocity) as it moves from the start"
+            )
+            raise InvalidArgumentError(msg)
+    return segments
+
+
 def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[tuple[Segment, ...], frozenset]:
     """Validate what an engine is given: segments, the collision filter, and :func:`check_fits`.
 
@@ -170,7 +190,7 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
     """
     segments = check_segments(segments, box)
     for k, segment in enumerate(segments):
-        if not _crosses_box(segment, box):
+        if not _crosses_box(segment.at(0.0), box):  # (a steered one where it was: not its new motion run back)
             msg = f"segments[{k}] {segment!r} lies entirely outside the box {box.width:g} x {box.height:g}"
             raise InvalidArgumentError(msg)
     if len(discs):
@@ -188,7 +208,7 @@ def check_scene(discs: Discs, box: Box, segments=(), pass_through=()) -> tuple[t
     if unknown:
         msg = f"pass_through names group label(s) {unknown} that no disc has (groups: {labels[:20]})"
         warnings.warn(msg, UserWarning, stacklevel=4)
-    check_fits(discs, box, segments=segments, pass_through=pass_through)
+    check_fits(discs, box, segments=[segment.at(0.0) for segment in segments], pass_through=pass_through)
     return segments, pass_through
 
 

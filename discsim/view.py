@@ -219,7 +219,7 @@ def _checkpoint_scene(path: Path):
 
     meta, _ = read_state(path)
     scene = meta.get("scene") or {}
-    segments = segments_from_rows(scene.get("segments"), path)
+    segments = segments_from_rows(scene.get("segments"), path, scene.get("segment_past"))
     sensors = sensors_from_rows(scene.get("sensors"), path)
     dt = (meta.get("settings") or {}).get("dt")
     return str(meta.get("engine", "EventDriven")), segments, (float(dt) if dt else None), sensors

@@ -38,7 +38,8 @@ from discsim.engines.base import Engine, EngineState, provide, registered_engine
 from discsim.errors import CheckpointError, DiscsimError
 from discsim.events import EVENT_DTYPE
 from discsim.io.container import read_state, write_state
-from discsim.model import Box, Discs, Segment, image_steps
+from discsim.io.streams import segment_past_rows, segments_from_rows
+from discsim.model import Box, Discs, image_steps
 from discsim.piston import Piston
 from discsim.scene import Scene
 from discsim.sensors import Sensor
@@ -68,6 +69,7 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
     run_id = context.ensure_run_id()
     scalars, arrays = engine.state().to_arrays()
     discs, box, scene = engine.discs, engine.box, engine.scene
+    steered = any(s.pieces() for s in scene.segments)  # (where a steered segment was before: plots, contacts)
     meta = {
         "layout": LAYOUT,
         "engine": type(engine).__name__,
@@ -80,6 +82,7 @@ def write_checkpoint(engine, path, *, run: dict | None, record: bool) -> Path:
             "segments": [
                 [*s.p0.tolist(), *s.p1.tolist(), *(s.velocity.tolist() if s.moving else [])] for s in scene.segments
             ],
+            **({"segment_past": [segment_past_rows(s) for s in scene.segments]} if steered else {}),
             "pass_through": sorted(scene.pass_through),
             "sensors": [[sensor.code, *sensor.params.tolist()] for sensor in scene.sensors],
             **({} if getattr(scene, "piston", None) is None else {"piston": scene.piston.settings()}),
@@ -239,8 +242,7 @@ def load(path, *, backend: str | None = None):
             scene_meta, settings, state, events = _first_layout(engine, meta, arrays)
         if backend is not None or (settings.get("backend") == "numba" and not numba_available()):
             settings = {**settings, "backend": backend or "auto"}
-        segments = [Segment(row[:2], row[2:4], row[4:6] if len(row) > 4 else (0.0, 0.0))
-                    for row in scene_meta.get("segments", [])]  # fmt: skip
+        segments = list(segments_from_rows(scene_meta.get("segments", []), path, scene_meta.get("segment_past")))
         pass_through = [tuple(pair) for pair in scene_meta.get("pass_through", [])]
         sensors = [Sensor(int(row[0]), row[1:]) for row in scene_meta.get("sensors", [])]
         piston = Piston(*scene_meta["piston"]) if scene_meta.get("piston") is not None else None

@@ -268,12 +268,14 @@ def segment_past_rows(segment: Segment) -> list[list[float]]:
     ]
 
 
-def segments_from_rows(rows, where) -> tuple[Segment, ...]:
+def segments_from_rows(rows, where, past=None) -> tuple[Segment, ...]:
     """The :class:`~discsim.model.Segment` s stored as :func:`segment_rows` (None: none), checked.
 
     Args:
         rows: the rows of an event log's header or a checkpoint's scene (4 numbers a fixed segment, 6 a moving one).
         where: the file they come from, named in the error.
+        past: for each segment, its :func:`segment_past_rows` (None: none steered): a steered one is rebuilt with
+            its earlier motions, and must come out as its row says.
 
     Raises:
         CheckpointError: naming the file and the first row that is not a valid segment.
@@ -285,11 +287,30 @@ def segments_from_rows(rows, where) -> tuple[Segment, ...]:
             if len(values) not in (4, 6):
                 msg = f"{len(values)} numbers, expected 4 (p0, p1) or 6 (p0, p1, velocity)"
                 raise ValueError(msg)
-            segments.append(Segment(values[:2], values[2:4], values[4:6] if len(values) == 6 else (0.0, 0.0)))
-        except (TypeError, ValueError, DiscsimError) as exc:
+            segment = Segment(values[:2], values[2:4], values[4:6] if len(values) == 6 else (0.0, 0.0))
+            segments.append(_with_past(segment, past[k] if past else ()))
+        except (TypeError, ValueError, IndexError, DiscsimError) as exc:
             msg = f"{where}: segments[{k}] = {row!r} is not a segment ({exc})"
             raise CheckpointError(msg) from exc
     return tuple(segments)
+
+
+def _with_past(segment: Segment, rows) -> Segment:
+    """``segment`` with the earlier motions ``rows`` (:func:`segment_past_rows`) replayed through
+    :meth:`~discsim.model.Segment.steered`, as the run steered it (the same arithmetic: the same end points)."""
+    if not rows:
+        return segment
+    rows = [[float(x) for x in row] for row in rows]
+    if any(len(row) != 7 for row in rows):
+        msg = f"its earlier motions {rows!r} are not rows of 7 numbers (until, p0, p1, velocity)"
+        raise ValueError(msg)
+    steered = Segment(rows[0][1:3], rows[0][3:5], rows[0][5:7])
+    for row, later in zip(rows, [*(row[5:7] for row in rows[1:]), segment.velocity]):
+        steered = steered.steered(row[0], later)
+    if not (np.array_equal(steered.p0, segment.p0) and np.array_equal(steered.p1, segment.p1)):
+        msg = f"its earlier motions {rows!r} do not lead to where it is"
+        raise ValueError(msg)
+    return steered
 
 
 def _resting(path, arrays, n: int) -> np.ndarray | None:

@@ -7,7 +7,8 @@ so no run can pass it, and the jam guard, which watches for a clock standing sti
 it only converges). This module finds such a crush before the run spends for ever on it:
 
 - :func:`lid_crush`: a kinematic lid moving down crushes the discs at the latest when it is lower than the largest
-  disc's diameter, or when the area under it is less than the discs' own area (whatever they do: it spans the box).
+  disc's diameter, or when the area under it is less than the discs' own area (whatever they do: it spans the box;
+  not when some discs pass through others, which then need no room of their own).
 - :func:`squeeze`: one disc between a kinematic wall and a wall or segment facing it (parallel), which stays
   between their ends until the gap closes, with no third wall, segment or disc it could reach before then (on the
   other discs' present speeds): a crush that nothing but the user (steering the wall) can prevent.
@@ -48,15 +49,16 @@ class _Wall(NamedTuple):
     kinematic: bool  # moves whatever hits it
 
 
-def lid_crush(radii: np.ndarray, width: float, height: float, velocity: float) -> Crush | None:
+def lid_crush(radii: np.ndarray, width: float, height: float, velocity: float, apart: bool = True) -> Crush | None:
     """When a kinematic lid at ``height`` moving at ``velocity`` (down: < 0) over discs of ``radii`` in a box of
-    ``width`` crushes them for certain: once it is below the largest diameter, or the area under it is below the
-    discs' area. None when it does not move down or there are no discs."""
+    ``width`` crushes them for certain: once it is below the largest diameter, or (when the discs keep ``apart``:
+    no collision filter lets some pass through others) the area under it is below the discs' area. None when it
+    does not move down or there are no discs."""
     if velocity >= 0.0 or not len(radii):
         return None
     k = int(np.argmax(radii))
     diameter = 2.0 * float(radii[k])
-    packed = float(np.sum(np.pi * radii**2)) / width
+    packed = float(np.sum(np.pi * radii**2)) / width if apart else 0.0
     if diameter >= packed:
         lowest, what = diameter, f"disc {k} (its diameter {diameter!r})"
     else:

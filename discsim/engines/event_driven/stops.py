@@ -259,7 +259,7 @@ class RunStops:
         if piston is not None and piston.kinematic:
             height, velocity, _, _ = self._piston_now()
             lid = (height, velocity)
-            crush = lid_crush(self.discs.radii, self.box.width, height, velocity)
+            crush = lid_crush(self.discs.radii, self.box.width, height, velocity, apart=not self.scene.pass_through)
             if crush is not None and self.time + crush.after <= until:
                 raise JammedError(self._crush_message(crush, "set_piston(velocity=...)"))
         last = self._backend.last_event()

@@ -55,7 +55,7 @@ from discsim.errors import CheckpointError, Interrupted, InvalidArgumentError
 from discsim.events import Event
 from discsim.laws import Laws
 from discsim.model import Box, Discs
-from discsim.scene import Scene
+from discsim.scene import Scene, check_unsteered
 from discsim.sensors import Sensor, check_sensors
 
 __all__ = ["BACKENDS", "BROAD_PHASES", "COMPILED_POLICIES", "POLICIES", "SUB_FRAME_POLICIES", "FixedStep"]
@@ -265,6 +265,7 @@ class FixedStep(FrameReadout, FixedStepRun, FrameSensing, Engine):
         tol = DEFAULT_BISECT_FRACTION * step if bisect_tol is None else positive_finite("bisect_tol", bisect_tol)
         laws = _check_laws(Laws.build(gravity, restitution, tc, rest_speed, roughness, drag), policy)
         backend, sensors = _choose_backend(backend, policy), check_sensors(sensors)
+        segments = check_unsteered(segments)  # (a checkpoint's, loaded, keeps where they were)
         scene = _moving_segments(Scene(discs, box, segments, pass_through, sensors=sensors), laws, policy)
         laws = laws.checked(scene)
         self._configure(scene, record, rate, step, by_rate, policy, broad_phase, tol, backend, laws, sensors)

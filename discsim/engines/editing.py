@@ -35,6 +35,10 @@ class SegmentEditing:
     time: float
     _edits: int
 
+    def _gave(self, masses: np.ndarray, velocities: np.ndarray) -> None:
+        """An edit gave discs of ``masses`` ``(K,)`` these ``velocities`` ``(K, 2)`` (nothing here; an engine that
+        watches the energy its discs were given takes it)."""
+
     def _check_editable(self, what: str) -> None:
         """Refuse ``what`` before anything changes, where the engine cannot take it."""
 
@@ -222,6 +226,7 @@ class DiscEditing(SegmentEditing):
         if self._logging or context.streamed:
             context.log.add(self.time, ids, discs.positions, discs.velocities, discs.radii, discs.masses, discs.groups)
         _log_woken(self, resting)
+        self._gave(discs.masses, discs.velocities)
         self._edits += k
         return np.arange(n, n + k, dtype=np.int64)
 
@@ -403,6 +408,7 @@ class DiscEditing(SegmentEditing):
         resting = _resting_ids(self)
         if len(idx):
             self._set_discs(idx, positions, velocities)
+            self._gave(self.discs.masses[idx], np.asarray(velocities, dtype=float).reshape(-1, 2))
         self._edits += len(idx)
         if (self._logging or self.run_context.streamed) and len(idx):  # a streamed log takes it at the next run
             t, pos, vel, ids = self.time, self.positions[idx], self.velocities[idx], self.ids[idx]

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from discsim.cells import neighbour_pairs
+from discsim.engines.context import LookOnly
 from discsim.engines.event_driven.piston import check_room
 from discsim.engines.event_driven.protocol import Backend
 from discsim.engines.event_driven.squeeze import Crush, lid_crush, squeeze
@@ -90,6 +91,7 @@ class RunStops:
     time: float
 
     _edits: int
+    run_context: Any
 
     if TYPE_CHECKING:  # the engine's own methods, named for the type checker only (at run time they would
         # come before the engine's in the method order)
@@ -108,7 +110,8 @@ class RunStops:
 
     def _advance(self, until: float, limit: int | None) -> int:
         log = self._log if self._logging else None
-        self._speed_reference()  # (before the walls squeeze anything: at the first run after an edit)
+        if self._given is None and self._kinematic:  # (before the walls squeeze anything)
+            self._given = _energy(self.discs.masses, self.velocities)
         try:
             if until != INF:
                 return self._chunked(until, limit, log)
@@ -253,20 +256,23 @@ class RunStops:
         room for the discs (:func:`~discsim.engines.event_driven.squeeze.lid_crush`), or a wall that squeezes the
         last event's disc against a wall facing it (:func:`~discsim.engines.event_driven.squeeze.squeeze`; not
         under drag or roughness, nor in a periodic box). O(N + walls^2), once per half a jam threshold of events,
-        so that it looks at the walls as callbacks and observers left them."""
+        so that it looks at the walls as observers left them. With a callback that may change the run
+        (``sim.on(kind, fn)`` without ``changes=False``: it may steer the walls before the crush) only the backstop
+        (:meth:`_check_speedup`) looks."""
         piston, laws = self.scene.piston, self.laws
+        steerable = any(not isinstance(fn, LookOnly) for fns in self.run_context.handlers.values() for fn in fns)
         lid = None
         if piston is not None and piston.kinematic:
             height, velocity, _, _ = self._piston_now()
             lid = (height, velocity)
             crush = lid_crush(self.discs.radii, self.box.width, height, velocity, apart=not self.scene.pass_through)
-            if crush is not None and self.time + crush.after <= until:
+            if crush is not None and self.time + crush.after <= until and not steerable:
                 raise JammedError(self._crush_message(crush, "set_piston(velocity=...)"))
         last = self._backend.last_event()
         if last is None or (lid is None and not self.scene.moving):
             return
         velocities, segments = self.velocities, [segment.at(self.time) for segment in self.scene.segments]
-        if not (laws.drag or laws.rough or self.box.periodic):
+        if not (laws.drag or laws.rough or self.box.periodic or steerable):
             args = (self.positions, velocities, self.discs.radii, laws.gravity, last[2], until - self.time)
             crush = squeeze(self.box, segments, lid, *args)
             if crush is not None:
@@ -274,53 +280,46 @@ class RunStops:
         self._check_speedup(velocities)
 
     #: A run with kinematic walls raises :class:`~discsim.errors.JammedError` when a disc moves this many times
-    #: faster than the discs' energy (at the last edit) and the walls' speeds allow: a crush that
-    #: :func:`~discsim.engines.event_driven.squeeze.squeeze` cannot prove (several discs squeezed together; drag,
-    #: roughness, a periodic box), whose speeds grow with every bounce (by about the walls' speed each).
+    #: faster than the energy the discs were given (at the start and by edits) and the walls' speeds allow: a crush
+    #: that :func:`~discsim.engines.event_driven.squeeze.squeeze` cannot prove (several discs squeezed together;
+    #: drag, roughness, a periodic box, a callback that may steer), whose speeds grow by about the walls' speed
+    #: at every bounce.
     squeeze_speedup: float = 1e4
-    _speed_scale: tuple[tuple[int, float], float] | None = None  # ((edits, piston change), speed scale) when taken
-    _piston_since: float
+    #: ``sum m v^2`` over the discs of finite mass when the walls became kinematic, plus what each edit gave the
+    #: discs it set (never taken afresh from the discs, whose speeds the walls may have pumped up); None before.
+    _given: float | None = None
+
+    def _gave(self, masses: np.ndarray, velocities: np.ndarray) -> None:
+        """An edit set discs of ``masses`` ``(K,)`` to ``velocities`` ``(K, 2)``: the backstop's energy takes it."""
+        if self._given is not None:
+            self._given += _energy(masses, velocities)
 
     def _check_speedup(self, velocities: np.ndarray) -> None:
         """The backstop of :meth:`_check_squeeze`: raise on a disc faster than ``squeeze_speedup`` times the speed
-        scale: ``sqrt(sum m v^2 / min m)`` (what the discs' kinetic energy allows one disc at the last edit), the
-        speed of a fall across the box, and the kinematic walls' speeds."""
-        finite = np.isfinite(self.discs.masses)
-        speeds = np.where(finite, np.hypot(velocities[:, 0], velocities[:, 1]), 0.0)
-        scale = self._speed_reference()
-        k = int(np.argmax(speeds)) if len(speeds) else 0
-        if scale > 0.0 and len(speeds) and speeds[k] > self.squeeze_speedup * scale:
-            msg = (
-                f"disc {k} moves at {float(speeds[k]):.6g}, {self.squeeze_speedup:g} times the speed scale of the "
-                f"run ({scale:.6g}: the discs' energy at the last edit, a fall across the box and the kinematic "
-                f"walls' speeds) at time {self.time!r}: kinematic walls squeeze it against others or a wall, and "
-                "its bounces pile up before they close on it; steer the walls (set_segment_velocity, "
-                "set_piston(velocity=...)) or stop the run earlier"
-            )
-            raise JammedError(msg)
-
-    def _speed_reference(self) -> float:
-        """The speed scale of :meth:`_check_speedup`, taken at the first run after each edit of the discs or the
-        piston (O(N) with kinematic walls, else 0.0; kept)."""
-        kept, key = self._speed_scale, (self._edits, self._piston_since)
-        if kept is not None and kept[0] == key:
-            return kept[1]
-        if not self._kinematic:
-            self._speed_scale = (key, 0.0)
-            return 0.0
-        masses, velocities = self.discs.masses, self.velocities
+        scale: ``sqrt(given / min m)`` (what the energy the discs were given allows one disc), the speed of a fall
+        across the box, and the kinematic walls' speeds now."""
+        masses = self.discs.masses
         finite = np.isfinite(masses)
-        energy = 0.0
-        if finite.any():
-            energy = float(np.sum(masses[finite] * np.sum(velocities[finite] ** 2, axis=1))) / masses[finite].min()
+        if not finite.any():
+            return
+        speeds = np.where(finite, np.hypot(velocities[:, 0], velocities[:, 1]), 0.0)
         fall = 2.0 * float(np.hypot(*self.laws.gravity)) * float(self.box.width + self.box.height)
         walls = [float(np.hypot(*segment.velocity)) for segment in self.scene.segments]
         piston = self.scene.piston
         if piston is not None and piston.kinematic:
             walls.append(abs(self._piston_now()[1]))
-        scale = max(math.sqrt(energy + fall), *walls)
-        self._speed_scale = (key, scale)
-        return scale
+        given = self._given if self._given is not None else _energy(masses, velocities)
+        scale = max(math.sqrt(given / float(masses[finite].min()) + fall), *walls)
+        k = int(np.argmax(speeds))
+        if scale > 0.0 and speeds[k] > self.squeeze_speedup * scale:
+            msg = (
+                f"disc {k} moves at {float(speeds[k]):.6g}, {self.squeeze_speedup:g} times the speed scale of the "
+                f"run ({scale:.6g}: the energy the discs were given, a fall across the box and the kinematic "
+                f"walls' speeds) at time {self.time!r}: kinematic walls squeeze it against others or a wall, and "
+                "its bounces pile up before they close on it; steer the walls (set_segment_velocity, "
+                "set_piston(velocity=...)) or stop the run earlier"
+            )
+            raise JammedError(msg)
 
     def _crush_message(self, crush: Crush, steer: str) -> str:
         at = self.time + crush.after
@@ -471,3 +470,9 @@ class RunStops:
                 if not never.all():
                     return False
         return True
+
+
+def _energy(masses: np.ndarray, velocities: np.ndarray) -> float:
+    """``sum m v^2`` over the discs of finite mass."""
+    finite = np.isfinite(masses)
+    return float(np.sum(masses[finite] * np.sum(velocities[finite] ** 2, axis=1)))

@@ -27,13 +27,6 @@ def test_a_lid_over_ghost_discs_that_pass_through_each_other_is_not_bounded_by_t
         sim.run(until=9.0, events=2_000_000)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=JammedError,
-    reason="lid_crush / squeeze take the walls' present motion as certain, but a callback may steer them before "
-    "the crush: in a busy gas the first look (half a jam threshold of events) comes long before the callback's "
-    "steer and refuses a run that would never be crushed",
-)
 def test_a_lid_a_callback_steers_up_half_way_to_the_crush_does_not_stop_a_busy_gas():
     # 20 fast discs under a lid from 28.07 at -1: their area would be reached at t = 25.56, but a callback turns the
     # lid up at half that time. The run was refused at t = 4.43.
@@ -66,12 +59,6 @@ def test_the_backstop_stops_a_row_of_discs_squeezed_by_a_paddle():
     sim._check()
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="each edit retakes the backstop's speed scale from the discs' present speeds: a callback that edits "
-    "anything at each contact (here it re-aims the paddle at the velocity it has) resets the scale to the speeds the "
-    "squeeze already pumped up, so the backstop never fires and run(until=20) creeps towards t = 5 for ever",
-)
 def test_the_backstop_stops_a_squeeze_whose_callback_steers_the_paddle_at_each_contact():
     sim = row_squeeze()
     sim.on("segment", lambda sim, _: sim.set_segment_velocity(0, (-1.0, 0.0)))  # (a paddle AI: the same velocity)

@@ -265,7 +265,7 @@ def test_random_pairs_against_brute_force_quick(compiled):
 
 @pytest.mark.slow
 def test_random_pairs_against_brute_force_thousands(compiled):
-    seen = _check_against_brute_force(compiled["toi"], seed=2, pairs=3000, samples=40_000)
+    seen = _check_against_brute_force(compiled["toi"], seed=2, pairs=2000, samples=20_000)
     assert seen["contacts"] > 800 and seen["both"] >= seen["contacts"] - 20
 
 

@@ -9,6 +9,8 @@ and states) asks these modules, never its own copy:
 - :mod:`.laws`: what an impact does to the velocities (today elastic and frictionless).
 - :mod:`.sources`: the kinds of event, each with its ``predict`` and ``resolve`` written over the two above:
   pairs, walls, segments and cell crossings.
+- :mod:`.polygons`: rotating convex polygons, the certified first contact of two (and of one with a line); no
+  engine uses it yet.
 
 Every function here is a plain function of floats that uses only arithmetic, comparisons and :mod:`math`, so
 that the same source runs in CPython and, jitted by numba (``discsim._compiled.jit``), inside the compiled

@@ -50,3 +50,13 @@ def test_a_read_only_fresh_state_shares_the_discs_and_equals_the_copied_one():
         assert np.array_equal(getattr(shared, name), getattr(copied, name)), name
     for name in ("kept_time", "kept_partner", "kept_stamp", "order", "resting", "last_collision", "spins", "angles"):
         assert np.array_equal(getattr(shared, name), getattr(copied, name)), name
+
+
+@pytest.mark.skipif(not _numba.available(), reason="numba is not installed (the fast extra)")
+def test_the_compiled_backend_builds_no_table_of_cell_shifts():
+    # The pure-Python predictor's per-cell shifts cost 8 bytes a cell (about 21 a disc) and a Python loop over
+    # every cell at construction; the compiled backend never reads them.
+    sim = ds.EventDriven(*ds.random_gas(5_000, 0.3, seed=2), backend="numba", record=False)
+    sim.run(events=1_000)
+    assert "shifts" not in vars(sim.grid)
+    assert len(sim.grid.shifts) == len(sim.grid)  # built when asked for

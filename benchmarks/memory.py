@@ -10,12 +10,13 @@ backend="numba")`` (the default ``record=True``), ``sim.run(events=...)`` (``EVE
 ``sim.snapshot()``. After each stage it reads the process's resident memory (``VmRSS``) and its peak so far
 (``VmHWM``, from ``/proc/self/status``). ``memory_before.csv`` holds the same stages measured by hand before the
 start state stopped copying the discs (its last stage reads ``sim.positions``, not a snapshot; 500,000 events at
-10^6): at N = 10^7 the constructor's peak fell from 4,337 to 3,496 MB. What is left at 10^7, after the constructor:
-numba and the interpreter 170 MB, the discs 57 bytes a disc, the scene and cell grid about 53 (22 of them the grid's
-per-cell table of shifts, 8 the scene's group of each disc: tracemalloc at 10^6), the backend's arrays about 154
-(``nbytes()``), the rest the allocator's; the peak adds the start state (order, cells and members, about 45 bytes a
-disc) and the load's temporaries. A snapshot is a new ``Discs`` (about 73 bytes a disc). Figures, as printed and
-written to ``memory.csv``:
+10^6): at N = 10^7 the constructor's peak fell from 4,337 to 3,295 MB (and its CPU time at 10^4 from 77 to 10 ms:
+the grid no longer builds the pure-Python predictor's table of shifts). What is left at 10^7 after the constructor,
+271 bytes a disc over numba and the interpreter (170 MB): the discs 57, the backend's arrays about 154
+(``nbytes()``), the scene's group of each disc 8, the rest (about 50) not broken down further; the peak adds the
+start state (order, cells and members, about 45 bytes a disc) and the load's temporaries. A snapshot is a new
+``Discs`` (about 73 bytes a disc) and, with its temporaries, sets the whole path's peak (4,038 MB). Figures, as
+printed and written to ``memory.csv``:
 
 * ``RSS MB``, ``peak MB``: the process's resident memory after the stage and its peak so far (the interpreter,
   numpy and numba included: what the operating system must give the run);

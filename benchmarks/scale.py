@@ -3,15 +3,15 @@
 Run ``python benchmarks/scale.py`` (4 to 5 minutes on this project's 2 shared cores: 3 runs per point, 1 at
 N = 10^6), ``--huge`` to add N = 10^7 (measured here for ``mono 0.3`` alone, ``--huge --sizes 10000000
 --gases "mono 0.3" --repeats 1 --stem scale_huge``: 3 minutes, most of it building the engine, and 4.3 GB of
-peak memory; the mixture's construction at 10^6 already peaks at 1.8 GB, so the four gases at 10^7 were
-not tried on this 23 GB machine), ``--sizes 1000 10000`` for some sizes only, or ``--quick``
-(seconds: proves the script runs).
+peak memory before the start state stopped copying the discs: ``memory.py``; the mixture's construction at
+10^6 already peaks at 1.8 GB, so the four gases at 10^7 were not tried on this 23 GB machine), ``--sizes 1000
+10000`` for some sizes only, or ``--quick`` (seconds: proves the script runs).
 
 For each gas and N, a seeded periodic gas is built through the public API (``import discsim as ds``), run
 for ``WARMUP_PER_DISC`` collisions per disc (at most ``WARMUP_MAX``) untimed, then timed over ``TIMED``
 collisions with ``time.perf_counter``, in a fresh Python process per run (``call_fresh``). Repeat by repeat,
 every point runs once before any runs again, so that a slow spell of the shared machine spreads over all
-points. The gases (``GASES``):
+points. Where the peak memory goes, stage by stage: ``benchmarks/memory.py``. The gases (``GASES``):
 
 * ``mono 0.3``, ``mono 0.7``: equal discs at packing 0.3 and 0.7 (``ds.random_gas``, lattice start: the
   0.7 gas is still a crystal melting during the timed run; its rate is the engine's all the same);

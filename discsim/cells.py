@@ -121,7 +121,6 @@ class CellGrid:
         self.box = box
         self.nx, self.ny = nx, ny
         self.lx, self.ly = box.width / nx, box.height / ny
-        self.shifts = self._build_tables(with_neighbours=False)[1]
 
     def __len__(self) -> int:
         return self.nx * self.ny
@@ -147,6 +146,12 @@ class CellGrid:
                 table[c].append(k)
         empty: tuple[int, ...] = ()
         return [tuple(cell) if cell else empty for cell in table]
+
+    @functools.cached_property
+    def shifts(self) -> list[tuple]:
+        """The offsets of each cell's neighbours (see the class docstring); built on first use (the pure-Python
+        backend's predictor reads them; the compiled one never does), 8 bytes a cell and a loop over the cells."""
+        return self._build_tables(with_neighbours=False)[1]
 
     @functools.cached_property
     def neighbours(self) -> list[tuple[int, ...]]:

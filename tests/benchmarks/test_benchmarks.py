@@ -295,6 +295,20 @@ def test_scale_script_writes_a_row_per_gas_and_size_and_its_plot(tmp_path):
     assert (tmp_path / "scale.png").stat().st_size > 0
 
 
+@pytest.mark.slow  # 4 s
+@pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
+def test_memory_script_writes_a_row_per_stage(tmp_path):
+    done = run_quick("memory.py", tmp_path)
+    assert done.returncode == 0, done.stderr
+    rows = read_csv(tmp_path / "memory.csv")
+    assert [row["stage"] for row in rows] == ["tiny run", "random_gas", "EventDriven", "run", "snapshot"]
+    assert {int(row["n"]) for row in rows} == {20_000} and float(rows[0]["rss_per_disc"]) == 0.0
+    for row in rows:  # the peak so far never falls, and bounds the memory now
+        assert float(row["rss_mb"]) <= float(row["peak_mb"])
+    peaks = [float(row["peak_mb"]) for row in rows]
+    assert peaks == sorted(peaks) and float(rows[2]["rss_per_disc"]) > 64  # the engine's arrays, at least
+
+
 @pytest.mark.slow  # 2 s
 @pytest.mark.skipif(not ds._numba.available(), reason="numba is not installed (the fast extra)")
 def test_memory_order_script_writes_each_order(tmp_path):

@@ -53,13 +53,27 @@ def cell_order(grid: CellGrid, cells: np.ndarray, before: np.ndarray | None = No
     return before[np.argsort(key, kind="stable")].astype(np.int64)
 
 
-def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
-    """The state at time 0 from the scene's discs, with an empty queue (the backend predicts every disc)."""
+def fresh_state(scene: Scene, grid: CellGrid, *, read_only: bool = False) -> EventDrivenState:
+    """The state at time 0 from the scene's discs, with an empty queue (the backend predicts every disc).
+
+    With ``read_only``, for a backend's ``load`` that only reads it: the discs' positions, velocities and spins
+    are the scene's own arrays, and the per-disc constants (zeros, infinities, -1) are read-only broadcast
+    views, so that the state costs about 24 bytes a disc (its numbering and cells), not 150 (issue 32).
+    """
     discs = scene.discs
     n = len(discs)
-    order = internal_order(grid, discs.positions) if n >= RENUMBER_MIN else np.arange(n)
     cell = grid.cells_of(discs.positions)
+    order = cell_order(grid, cell) if n >= RENUMBER_MIN else np.arange(n)  # as internal_order, cells found once
     members = order[np.argsort(cell[order], kind="stable")]  # by cell, then internal number
+
+    def own(values: np.ndarray) -> np.ndarray:
+        return values if read_only else np.array(values)
+
+    def constant(value, shape: tuple = (n,), dtype=np.float64) -> np.ndarray:
+        if read_only:
+            return np.broadcast_to(np.asarray(value, dtype), shape)
+        return np.full(shape, value, dtype) if value else np.zeros(shape, dtype)
+
     empty_queue = np.zeros(0, dtype=np.int64)
     given = scene.piston  # its height and velocity at time 0, no impact yet, its pressure
     piston = np.zeros(0) if given is None else np.array([scene.piston_height, given.velocity, 0.0, 0.0, given.pressure])
@@ -81,27 +95,27 @@ def fresh_state(scene: Scene, grid: CellGrid) -> EventDrivenState:
         last_j=-1,
         grid_nx=grid.nx,
         grid_ny=grid.ny,
-        ref_positions=np.array(discs.positions),
-        velocities=np.array(discs.velocities),
-        ref_times=np.zeros(n),
-        images=np.zeros((n, 2), dtype=np.int64),
-        collision_counts=np.zeros(n, dtype=np.int64),
+        ref_positions=own(discs.positions),
+        velocities=own(discs.velocities),
+        ref_times=constant(0.0),
+        images=constant(0, (n, 2), np.int64),
+        collision_counts=constant(0, dtype=np.int64),
         cell=cell,
         cell_members=members,
         cell_sizes=np.bincount(cell, minlength=len(grid)).astype(np.int64),
-        kept_time=np.full(n, math.inf),
-        kept_partner=np.full(n, -1, dtype=np.int64),
-        kept_stamp=np.zeros(n, dtype=np.int64),
+        kept_time=constant(math.inf),
+        kept_partner=constant(-1, dtype=np.int64),
+        kept_stamp=constant(0, dtype=np.int64),
         order=np.asarray(order, dtype=np.int64),
         queue_owner=empty_queue,
         queue_time=np.zeros(0),
         queue_kind=empty_queue,
         queue_other=empty_queue,
         queue_stamp=empty_queue,
-        resting=np.zeros(n, dtype=np.int64),
-        last_collision=np.full(n, -math.inf),
-        spins=np.array(discs.spins),
-        angles=np.zeros(n),
+        resting=constant(0, dtype=np.int64),
+        last_collision=constant(-math.inf),
+        spins=own(discs.spins),
+        angles=constant(0.0),
         sensed=inside_table(scene.sensors, discs.positions, scene.box),
         piston=piston,
     )

@@ -168,7 +168,7 @@ class NumbaBackend(CompiledReads):
     def start(self, state: EventDrivenState | None = None) -> None:
         """A fresh run at time 0 from the scene's discs (or from ``state``, a fresh state with an empty queue
         whose clock moved on): every moving disc predicted at the epoch, in internal order."""
-        self.load(fresh_state(self.scene, self.grid) if state is None else state)
+        self.load(fresh_state(self.scene, self.grid, read_only=True) if state is None else state)
         carried = int(self._ints[self._lp.I_MAXQ])
         self._lp.predict_all(*self._predict_args())
         self._ints[self._lp.I_MAXQ] = max(carried, int(self._ints[self._lp.I_MAXQ]))
@@ -189,11 +189,12 @@ class NumbaBackend(CompiledReads):
         rec[:, 6] = discs.masses[order]
         rec[:, 7] = state.kept_time[order]
         self._rec = rec
-        self._count = state.collision_counts[order].astype(np.int64)
+        self._count = state.collision_counts[order].astype(np.int64, copy=False)
         self._images = state.images[order].astype(np.int32)  # box lengths crossed: int32 holds 2^31 laps
         partner = state.kept_partner[order]
         self._kept_partner = np.where(partner >= 0, rank[np.maximum(partner, 0)], -1).astype(np.int32)
-        self._kept_stamp = state.kept_stamp[order].astype(np.int64)
+        del partner  # temporaries freed as soon as done: a large N's peak is the sum of what lives at once
+        self._kept_stamp = state.kept_stamp[order].astype(np.int64, copy=False)
         self._cell = state.cell[order].astype(np.int32)
         n_cells = len(self.grid)
         # Disc and cell indices are int32 (grids hold at most 4 N + 9 cells): a smaller state, fewer misses.
@@ -249,19 +250,23 @@ class NumbaBackend(CompiledReads):
         if sensed.shape != (n, len(sensors)):  # not kept (no sensor before): where the discs are now
             gravity = self.laws.gravity if self.laws.falls else None
             sensed = inside_table(sensors, state.positions_at(state.time, gravity, drag=self.laws.drag), self.box)
-        self._rest = np.concatenate([state.resting[order], sensed[order].ravel()]).astype(np.int8)
+        rest = self._rest = np.empty(n + sensed.size, dtype=np.int8)
+        rest[:n] = state.resting[order]
+        rest[n:] = sensed[order].ravel()
         seg = self._seg  # a moving segment's row: where it is at the epoch (as rebase puts it)
         moving = (seg[:, 6] != 0.0) | (seg[:, 7] != 0.0)
         seg[moving, 0:2] = seg[moving, 8:10] + seg[moving, 6:8] * state.epoch
         seg[moving, 2:4] = seg[moving, 10:12] + seg[moving, 6:8] * state.epoch
-        self._tlast = state.last_collision[order].astype(np.float64)
+        self._tlast = state.last_collision[order].astype(np.float64, copy=False)
         if self.scene.piston is not None:  # its numbers, last in edges
             _moving().put(self._edges, self.scene.piston.mass, state.piston, self.box.width, self.laws.gravity[1])
         self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
-        self._rot = np.column_stack(
-            [state.spins[order], discs.inertia[order], state.angles[order], np.full(n, float(state.time))]
-        ).reshape(n, 4)
+        rot = self._rot = np.empty((n, 4))  # filled column by column: no (N, 4) temporaries
+        rot[:, 0] = state.spins[order]
+        rot[:, 1] = discs.inertia[order]
+        rot[:, 2] = state.angles[order]
+        rot[:, 3] = state.time
         scene = self.scene
         self._egroup = scene.group[order].astype(np.int64) if len(scene) else np.zeros(1, dtype=np.int64)
         self._etab = self.laws.table(np.unique(scene.discs.groups))

@@ -97,7 +97,7 @@ class PythonBackend:
     def start(self, state: EventDrivenState | None = None) -> None:
         """A fresh run at time 0 from the scene's discs (or from ``state``, a fresh state with an empty queue
         whose clock moved on): every moving disc predicted at the epoch, in internal order."""
-        self.load(fresh_state(self.scene, self.grid) if state is None else state)
+        self.load(fresh_state(self.scene, self.grid, read_only=True) if state is None else state)
         predict, moving = self._predict, self._moving
         for i in range(len(moving)):
             if moving[i]:

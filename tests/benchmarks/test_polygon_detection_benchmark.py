@@ -24,4 +24,5 @@ def test_quick_mode_writes_the_detectors_rows_and_the_figure(tmp_path):
     assert all(int(row["contacts"]) > 0 for row in rows)
     slow, fast = float(rows[0]["pit_missed"]), float(rows[1]["pit_missed"])
     assert fast > slow  # PIT misses more as the squares turn faster per frame
+    assert all(float(row["pic_agrees"]) == 1.0 for row in rows)  # the certified time is the brute-force one
     assert (tmp_path / "polygon_detection_quick.png").stat().st_size > 10_000

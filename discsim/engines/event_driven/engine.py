@@ -151,8 +151,7 @@ class EventDriven(PistonRun, Turning, RunStops, Engine):
         laws = Laws.build(gravity, restitution, tc, rest_speed, roughness, drag)
         if laws.falls and laws.rest_speed is None and isinstance(discs, Discs):  # fixed now: added discs keep it
             laws = dataclasses.replace(laws, rest_speed=laws.rest_speed_for(discs.radii))
-        segments = check_unsteered(segments)  # (a checkpoint's, loaded, keeps where they were)
-        scene = Scene(discs, box, segments, pass_through, sensors=sensors, piston=piston)
+        scene = Scene(discs, box, check_unsteered(segments), pass_through, sensors=sensors, piston=piston)
         check_parts(scene, laws)
         self._configure(scene, record, queue, cell_size, backend, laws.checked(scene))
         self._backend.start()

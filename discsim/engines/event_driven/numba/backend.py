@@ -222,28 +222,7 @@ class NumbaBackend(CompiledReads):
         ints = self._ints = np.zeros(lp.N_INTS, dtype=np.int64)
         floats = self._floats = np.zeros(lp.N_FLOATS)
         ints[lp.I_SIZE] = len(owners)
-        ints[lp.I_PRED] = state.predictions
-        ints[lp.I_COLL] = state.collisions
-        ints[lp.I_WALL] = state.wall_hits
-        ints[lp.I_CROSS] = state.cell_crossings
-        ints[lp.I_STALE] = state.stale
-        ints[lp.I_SINCE] = state.since_rebase
-        ints[lp.I_MAXQ] = state.max_queue
-        ints[lp.I_LKIND] = state.last_kind
-        if state.last_kind >= 0:
-            ints[lp.I_LI] = rank[state.last_i]
-            pair = state.last_j >= 0 and state.last_kind not in SENSED  # a sensor's j is the sensor's index
-            ints[lp.I_LJ] = rank[state.last_j] if pair else state.last_j
-        else:
-            ints[lp.I_LI] = ints[lp.I_LJ] = -1
-        floats[lp.F_EPOCH] = state.epoch
-        floats[lp.F_VIRIAL] = state.virial
-        floats[lp.F_OVERLAP] = state.max_overlap
-        floats[lp.F_TIME] = state.time
-        floats[lp.F_LTIME] = state.last_time
-        floats[lp.F_LOST] = state.dissipated
-        ints[lp.I_RESTS] = state.rests
-        ints[lp.I_SENSE] = state.sensor_events
+        _counters(lp, state, rank, ints, floats)
         # Each disc's rest flag, then its side of each sensor (disc-major: n + i S + k; one array, so that
         # predict takes no more arguments than it may: see the edges above).
         sensed, sensors = state.sensed, self.scene.sensors
@@ -251,8 +230,7 @@ class NumbaBackend(CompiledReads):
             gravity = self.laws.gravity if self.laws.falls else None
             sensed = inside_table(sensors, state.positions_at(state.time, gravity, drag=self.laws.drag), self.box)
         rest = self._rest = np.empty(n + sensed.size, dtype=np.int8)
-        rest[:n] = state.resting[order]
-        rest[n:] = sensed[order].ravel()
+        rest[:n], rest[n:] = state.resting[order], sensed[order].ravel()
         seg = self._seg  # a moving segment's row: where it is at the epoch (as rebase puts it)
         moving = (seg[:, 6] != 0.0) | (seg[:, 7] != 0.0)
         seg[moving, 0:2] = seg[moving, 8:10] + seg[moving, 6:8] * state.epoch
@@ -263,10 +241,8 @@ class NumbaBackend(CompiledReads):
         self._found = np.zeros(n, dtype=np.int64)  # the loop's room for the discs a woken support held up
         # Each disc's turning: spin, inertia, angle, and the (absolute) time of that angle (loop.W ... ANGLE_T).
         rot = self._rot = np.empty((n, 4))  # filled column by column: no (N, 4) temporaries
-        rot[:, 0] = state.spins[order]
-        rot[:, 1] = discs.inertia[order]
-        rot[:, 2] = state.angles[order]
-        rot[:, 3] = state.time
+        for k, column in enumerate((state.spins[order], discs.inertia[order], state.angles[order], state.time)):
+            rot[:, k] = column
         scene = self.scene
         self._egroup = scene.group[order].astype(np.int64) if len(scene) else np.zeros(1, dtype=np.int64)
         self._etab = self.laws.table(np.unique(scene.discs.groups))
@@ -522,3 +498,30 @@ def _spin_records(events, k: int) -> np.ndarray:
     out["wi"] = ev_w[rows, 0]
     out["wj"] = ev_w[rows, 1]
     return out
+
+
+def _counters(lp, state, rank: np.ndarray, ints: np.ndarray, floats: np.ndarray) -> None:
+    """The loop's counters and clocks (``ints``, ``floats``, slots of the loop module ``lp``) from ``state``; the
+    last event's discs by their internal numbers (``rank``)."""
+    ints[lp.I_PRED] = state.predictions
+    ints[lp.I_COLL] = state.collisions
+    ints[lp.I_WALL] = state.wall_hits
+    ints[lp.I_CROSS] = state.cell_crossings
+    ints[lp.I_STALE] = state.stale
+    ints[lp.I_SINCE] = state.since_rebase
+    ints[lp.I_MAXQ] = state.max_queue
+    ints[lp.I_LKIND] = state.last_kind
+    if state.last_kind >= 0:
+        ints[lp.I_LI] = rank[state.last_i]
+        pair = state.last_j >= 0 and state.last_kind not in SENSED  # a sensor's j is the sensor's index
+        ints[lp.I_LJ] = rank[state.last_j] if pair else state.last_j
+    else:
+        ints[lp.I_LI] = ints[lp.I_LJ] = -1
+    floats[lp.F_EPOCH] = state.epoch
+    floats[lp.F_VIRIAL] = state.virial
+    floats[lp.F_OVERLAP] = state.max_overlap
+    floats[lp.F_TIME] = state.time
+    floats[lp.F_LTIME] = state.last_time
+    floats[lp.F_LOST] = state.dissipated
+    ints[lp.I_RESTS] = state.rests
+    ints[lp.I_SENSE] = state.sensor_events

@@ -258,6 +258,7 @@ def compiled():
     return {"toi": parts[polygon_time_of_impact], "wall": parts[polygon_wall_time]}
 
 
+@pytest.mark.slow  # (4 s, and numba compiling the parts; the closed forms above run quick)
 def test_random_pairs_against_brute_force_quick(compiled):
     seen = _check_against_brute_force(compiled["toi"], seed=1, pairs=60, samples=10_000)
     assert seen["contacts"] > 15 and seen["both"] >= seen["contacts"] - 1
@@ -269,6 +270,7 @@ def test_random_pairs_against_brute_force_thousands(compiled):
     assert seen["contacts"] > 800 and seen["both"] >= seen["contacts"] - 20
 
 
+@pytest.mark.slow
 def test_random_polygons_against_walls_with_brute_force(compiled):
     rng = np.random.default_rng(3)
     for _ in range(100):
@@ -287,6 +289,7 @@ def test_random_polygons_against_walls_with_brute_force(compiled):
 
 # --- compiled -------------------------------------------------------------------------------------------------
 @needs_numba
+@pytest.mark.slow
 def test_the_compiled_parts_equal_the_python_parts_bit_for_bit(compiled):
     rng = np.random.default_rng(4)
     cases = [BAR_CASE] + [_random_pair(rng) for _ in range(20)]

@@ -57,7 +57,9 @@ def test_mixed_radii_masses_and_obstacles_follow_the_oracle(periodic):
 
 
 @pytest.mark.slow_on_python  # (the pure-Python loop's oracle runs cover it: test_equal_discs_follow_the_oracle)
-@pytest.mark.parametrize("queue", ["heap", pytest.param("sorted", marks=pytest.mark.slow)])  # (the compiled loop
+@pytest.mark.parametrize(
+    "queue", [pytest.param(q, marks=pytest.mark.slow) for q in ("heap", "sorted")]
+)  # (the compiled loop
 # has one queue of its own: its two cases run the same events)
 def test_dense_gas_follows_the_oracle_with_the_other_queues(queue):
     discs, box = ds.random_gas(36, 0.6, periodic=True, seed=3)

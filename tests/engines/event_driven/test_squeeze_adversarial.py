@@ -10,6 +10,7 @@ import discsim as ds
 from discsim.errors import JammedError
 
 
+@pytest.mark.slow_on_python  # (3 s interpreted)
 def test_a_lid_over_ghost_discs_that_pass_through_each_other_is_not_bounded_by_their_area():
     # 30 discs of radius 0.5 that pass through each other take no room from one another: under a lid from 9 at -1
     # they fit until the lid is at their diameter 1 (t = 8). The area bound (their area over the box's width,
@@ -27,6 +28,7 @@ def test_a_lid_over_ghost_discs_that_pass_through_each_other_is_not_bounded_by_t
         sim.run(until=9.0, events=2_000_000)
 
 
+@pytest.mark.slow  # (8 s interpreted, 3 s compiled: 400,000 events)
 def test_a_lid_a_callback_steers_up_half_way_to_the_crush_does_not_stop_a_busy_gas():
     # 20 fast discs under a lid from 28.07 at -1: their area would be reached at t = 25.56, but a callback turns the
     # lid up at half that time. The run was refused at t = 4.43.

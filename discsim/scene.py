@@ -243,7 +243,7 @@ class Scene:
         segments: fixed :class:`~discsim.model.Segment` walls (walled boxes only).
         pass_through: pairs of group labels whose discs pass through each other.
         sensors: :class:`~discsim.sensors.Sensor` regions and trip wires (none by default); in a periodic box
-            a circle or rectangle must lie inside the box.
+            every one must lie inside the box.
         piston: a :class:`~discsim.piston.Piston` as the top wall of a walled box (None: none); every disc's top
             ``y + r`` at most its height, which is at most the box's.
         check: False for the scene of discs an engine already holds (``add_discs`` checks the new ones with
@@ -290,11 +290,14 @@ class Scene:
         if box.periodic:
             for k, sensor in enumerate(self.sensors):
                 x0, y0, x1, y1 = sensor.bounds()
-                if sensor.shape != "line" and not (0.0 <= x0 and x1 <= box.width and 0.0 <= y0 and y1 <= box.height):
-                    msg = (
-                        f"sensors[{k}] {sensor!r} must lie inside the periodic box {box.width:g} x {box.height:g} "
-                        "(a region across its edge would be entered without a crossing)"
+                if not (0.0 <= x0 and x1 <= box.width and 0.0 <= y0 and y1 <= box.height):
+                    why = (
+                        "a trip wire's part beyond the edge would never be crossed: the discs wrap"
+                        if sensor.shape == "line"
+                        else "a region across its edge would be entered without a crossing"
                     )
+                    size = f"{box.width:g} x {box.height:g}"
+                    msg = f"sensors[{k}] {sensor!r} must lie inside the periodic box {size} ({why})"
                     raise InvalidArgumentError(msg)
         self.discs = discs
         self.box = box

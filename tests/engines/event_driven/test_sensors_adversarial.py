@@ -211,3 +211,14 @@ def test_crossings_of_two_sensors_at_one_instant_come_in_the_sensors_order():
     sim = ds.EventDriven(ds.Discs([[1.0, 5.3]], [[1.0, 0.0]], radii=0.2), ds.Box(10.0, 10.0), sensors=sensors)
     sim.run(until=6.0)
     assert [(k, j) for _, k, _, j in crossings(sim)] == [("enter", 0), ("enter", 1), ("leave", 0), ("leave", 1)]
+
+
+def test_a_trip_wire_reaching_beyond_a_periodic_box_is_refused_naming_it():
+    # Its part beyond the edge x = 0 would never be crossed (the discs wrap to x = 10): it was accepted, and the
+    # wrapped part never reported (found by the issue 28 trip-wire fix).
+    discs = ds.Discs([[5.0, 2.0]], [[1.0, 0.0]], radii=0.2)
+    with pytest.raises(
+        ds.DiscsimError, match=r"sensors\[1\] .* must lie inside the periodic box 10 x 10 \(a trip wire"
+    ):
+        wires = [Sensor.line((3.0, 0.0), (3.0, 10.0)), Sensor.line((-2.0, 5.0), (3.0, 5.0))]
+        ds.EventDriven(discs, ds.Box(10.0, 10.0, periodic=True), sensors=wires)
